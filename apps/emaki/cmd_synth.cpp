@@ -1,0 +1,338 @@
+// `emaki synth`: guided synthesis from files. Accepts EbSynth's command line unchanged (single-
+// dash options, `-weight` applying to the -style or -guide before it), so scripts that call
+// `ebsynth` switch by changing the program name; adds long options of its own.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fmt/format.h>
+#include <optional>
+#include <string>
+
+#include "apps/emaki/commands.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "io/image_io.h"
+#include "synth/synthesizer.h"
+
+namespace emaki::app {
+namespace {
+
+constexpr const char* kHelp = R"(usage: emaki synth -style A'.png -guide A1.png B1.png [-weight W] [-guide ...] -output B'.png [options]
+
+Guided patch-based synthesis (A : A' :: B : B'). Accepts EbSynth's command line unchanged.
+
+EbSynth options (single dash)
+  -style FILE           style exemplar A' (1-4 channels; an RGB image whose channels are all
+                        equal counts as one channel, as in EbSynth). Required.
+  -guide SRC TGT        a guide pair: SRC has the style's size, TGT the output's. Repeatable,
+                        at least one. 1-4 channels each (equal-channel RGB counts as one).
+  -weight W             weight (>= 0) of the -style or -guide just before it.
+                        Default: style 1; each guide 1 / number of guides.
+  -output FILE          output B' (.png, .exr, .tif, .jpg). Default: output.png
+  -uniformity U         uniformity weight, >= 0 (500-15000 sensible). Default: 3500
+  -patchsize N          patch size, odd, >= 3. Default: 5
+  -pyramidlevels N      pyramid levels, >= 1. Default: as many as fit
+  -searchvoteiters N    search-vote iterations per level, >= 0. Default: emaki's schedule
+                        (6 at coarse levels, 3 and 2 at the two finest)
+  -patchmatchiters N    PatchMatch iterations per search-vote iteration, >= 0. Default: emaki's
+                        schedule (4 at coarse levels, 3 and 2 at the two finest)
+  -stopthreshold N      accepted for compatibility; no effect (as in EbSynth's CPU backend)
+  -extrapass3x3         a final polishing pass with 3x3 patches. Default: off
+  -backend cpu|cuda|auto  accepted for compatibility; emaki always runs on the CPU
+
+emaki options
+  --seed N              random seed (same inputs and seed: bit-identical output). Default: 1
+  --threads N           worker threads, >= 0 (0: all cores). Default: 0
+  --mask FILE           target mask (first channel > 0 is inside): outside pixels are not
+                        synthesized and come out transparent (B' gets an alpha channel)
+  --vote plain|weighted voting mode. Default: weighted
+  --nnf-out FILE        write the nearest-neighbour field (EXR: float x, y of the source patch
+                        centre; -1 outside the mask)
+  --error-out FILE      write the per-pixel patch error (EXR, EbSynth units)
+  --output-depth 8|16|float  output sample format. Default: that of the style image
+  --quiet               no summary line
+  --help                this text
+)";
+
+struct GuideArg {
+  std::string source, target;
+  float weight = -1.0f;
+};
+
+int parse_int(const std::string& opt, const std::string& v) {
+  try {
+    std::size_t pos = 0;
+    const int n = std::stoi(v, &pos);
+    if (pos != v.size()) throw std::invalid_argument(v);
+    return n;
+  } catch (const std::exception&) {
+    throw Error(opt, "expects an integer, got '" + v + "'");
+  }
+}
+
+float parse_float(const std::string& opt, const std::string& v) {
+  try {
+    std::size_t pos = 0;
+    const float f = std::stof(v, &pos);
+    if (pos != v.size() || !std::isfinite(f)) throw std::invalid_argument(v);
+    return f;
+  } catch (const std::exception&) {
+    throw Error(opt, "expects a number, got '" + v + "'");
+  }
+}
+
+// EbSynth counts an RGB image whose three channels are equal everywhere as one channel, and
+// drops an alpha channel that is opaque everywhere.
+int effective_channels(const io::AnyImage& im) {
+  const int nc = im.channels();
+  const int w = im.width(), h = im.height();
+  auto opaque = [&](int c) {
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        if (im.value(x, y, c) != 1.0f) return false;
+    return true;
+  };
+  auto gray = [&]() {
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float r = im.value(x, y, 0);
+        if (im.value(x, y, 1) != r || im.value(x, y, 2) != r) return false;
+      }
+    return true;
+  };
+  if (nc == 4) return opaque(3) ? (gray() ? 1 : 3) : 4;
+  if (nc == 3) return gray() ? 1 : 3;
+  if (nc == 2) return opaque(1) ? 1 : 2;
+  return nc;
+}
+
+io::AnyImage reduce(io::AnyImage im, int channels) {
+  if (im.channels() == channels) return im;
+  if (channels == 2 && im.channels() == 4) {  // gray + alpha from RGBA
+    io::AnyImage out = im.select_channels(0, 4);
+    return out;
+  }
+  return im.select_channels(0, channels);
+}
+
+synth::Plane plane_of(const io::AnyImage& im) {
+  return std::visit([](const auto& i) -> synth::Plane { return i.view(); }, im.image);
+}
+
+void check_output_path(const std::string& opt, const std::string& path) {
+  try {
+    io::check_writable(path);
+  } catch (const Error& e) {
+    throw Error(opt + " " + path, std::string(e.what()).substr(path.size() + 2));
+  }
+}
+
+}  // namespace
+
+int run_synth(const Args& args) {
+  std::string style_path, output = "output.png", mask_path, nnf_out, error_out, depth;
+  float style_weight = -1.0f;
+  std::vector<GuideArg> guides;
+  synth::Params params;
+  int threads = 0;
+  bool quiet = false;
+  float* last_weight = nullptr;
+
+  auto need = [&](std::size_t& i, const std::string& opt) -> const std::string& {
+    if (i + 1 >= args.size()) throw Error(opt, "is missing its value");
+    return args[++i];
+  };
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    } else if (a == "-style") {
+      style_path = need(i, a);
+      last_weight = &style_weight;
+    } else if (a == "-guide") {
+      GuideArg g;
+      if (i + 2 >= args.size() || args[i + 1].rfind("-", 0) == 0 || args[i + 2].rfind("-", 0) == 0)
+        throw Error("-guide", "needs two paths: the source guide and the target guide");
+      g.source = args[++i];
+      g.target = args[++i];
+      guides.push_back(g);
+      last_weight = &guides.back().weight;
+    } else if (a == "-weight") {
+      const float w = parse_float(a, need(i, a));
+      if (!last_weight) throw Error("-weight", "must follow a -style or -guide option");
+      if (w < 0.0f) throw Error("-weight", "must be >= 0");
+      *last_weight = w;
+    } else if (a == "-output") {
+      output = need(i, a);
+    } else if (a == "-uniformity") {
+      params.uniformity = parse_float(a, need(i, a));
+      if (params.uniformity < 0.0f) throw Error(a, "must be >= 0");
+    } else if (a == "-patchsize") {
+      params.patch_size = parse_int(a, need(i, a));
+      if (params.patch_size < 3) throw Error(a, fmt::format("must be >= 3 (got {})", params.patch_size));
+      if (params.patch_size % 2 == 0) throw Error(a, fmt::format("must be odd (got {})", params.patch_size));
+    } else if (a == "-pyramidlevels") {
+      params.pyramid_levels = parse_int(a, need(i, a));
+      if (params.pyramid_levels < 1) throw Error(a, "must be >= 1");
+    } else if (a == "-searchvoteiters") {
+      params.search_vote_iters = parse_int(a, need(i, a));
+      if (params.search_vote_iters < 0) throw Error(a, "must be >= 0");
+    } else if (a == "-patchmatchiters") {
+      params.patch_match_iters = parse_int(a, need(i, a));
+      if (params.patch_match_iters < 0) throw Error(a, "must be >= 0");
+    } else if (a == "-stopthreshold") {
+      if (parse_int(a, need(i, a)) < 0) throw Error(a, "must be >= 0");
+    } else if (a == "-extrapass3x3") {
+      params.extra_pass_3x3 = true;
+    } else if (a == "-backend") {
+      const std::string b = need(i, a);
+      if (b != "cpu" && b != "cuda" && b != "auto")
+        throw Error(a, "must be cpu, cuda or auto (got '" + b + "')");
+    } else if (a == "--seed") {
+      const std::string v = need(i, a);
+      try {
+        std::size_t pos = 0;
+        params.seed = std::stoull(v, &pos);
+        if (pos != v.size()) throw std::invalid_argument(v);
+      } catch (const std::exception&) {
+        throw Error(a, "expects a non-negative integer, got '" + v + "'");
+      }
+    } else if (a == "--threads") {
+      threads = parse_int(a, need(i, a));
+      if (threads < 0) throw Error(a, "must be >= 0");
+    } else if (a == "--mask") {
+      mask_path = need(i, a);
+    } else if (a == "--vote") {
+      const std::string v = need(i, a);
+      if (v == "plain") params.vote_mode = synth::VoteMode::kPlain;
+      else if (v == "weighted") params.vote_mode = synth::VoteMode::kWeighted;
+      else throw Error(a, "must be plain or weighted (got '" + v + "')");
+    } else if (a == "--nnf-out") {
+      nnf_out = need(i, a);
+    } else if (a == "--error-out") {
+      error_out = need(i, a);
+    } else if (a == "--output-depth") {
+      depth = need(i, a);
+      if (depth != "8" && depth != "16" && depth != "float")
+        throw Error(a, "must be 8, 16 or float (got '" + depth + "')");
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else {
+      throw Error(a, "unknown option (see 'emaki synth --help')");
+    }
+  }
+  if (style_path.empty()) throw Error("-style", "is required (the style exemplar)");
+  if (guides.empty()) throw Error("-guide", "at least one guide pair is required");
+
+  // Fail on an unwritable output before any long work.
+  check_output_path("-output", output);
+  if (!nnf_out.empty()) check_output_path("--nnf-out", nnf_out);
+  if (!error_out.empty()) check_output_path("--error-out", error_out);
+  set_thread_count(threads);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  io::AnyImage style = io::read_image(style_path);
+  style = reduce(std::move(style), effective_channels(style));
+  if (style.channels() > 4) throw Error(style_path, "style must have 1 to 4 channels");
+
+  std::vector<io::AnyImage> loaded;
+  loaded.reserve(guides.size() * 2);
+  synth::Inputs in;
+  in.style = plane_of(style);
+  in.style_name = style_path;
+  for (const auto& g : guides) {
+    io::AnyImage s = io::read_image(g.source);
+    io::AnyImage t = io::read_image(g.target);
+    if (s.width() != style.width() || s.height() != style.height())
+      throw Error(g.source, fmt::format("source guide is {}x{} but the style '{}' is {}x{}",
+                                        s.width(), s.height(), style_path, style.width(),
+                                        style.height()));
+    const int nc = std::max(effective_channels(s), effective_channels(t));
+    if (nc > 4) throw Error(g.source, "a guide must have 1 to 4 channels");
+    loaded.push_back(reduce(std::move(s), std::min(nc, 4)));
+    loaded.push_back(reduce(std::move(t), std::min(nc, 4)));
+    const io::AnyImage& ls = loaded[loaded.size() - 2];
+    const io::AnyImage& lt = loaded.back();
+    if (ls.channels() != lt.channels())
+      throw Error(g.target, fmt::format("has {} channels but its source guide '{}' has {}",
+                                        lt.channels(), g.source, ls.channels()));
+    synth::GuidePair gp;
+    gp.name = g.target;
+    gp.source = plane_of(ls);
+    gp.target = plane_of(lt);
+    gp.weight = g.weight;
+    in.guides.push_back(gp);
+  }
+  // Name the right file when sizes disagree.
+  for (std::size_t k = 1; k < in.guides.size(); ++k)
+    if (synth::plane_width(in.guides[k].target) != synth::plane_width(in.guides[0].target) ||
+        synth::plane_height(in.guides[k].target) != synth::plane_height(in.guides[0].target))
+      throw Error(guides[k].target,
+                  fmt::format("target guide is {}x{} but '{}' is {}x{}",
+                              synth::plane_width(in.guides[k].target),
+                              synth::plane_height(in.guides[k].target), guides[0].target,
+                              synth::plane_width(in.guides[0].target),
+                              synth::plane_height(in.guides[0].target)));
+  io::AnyImage mask;
+  if (!mask_path.empty()) {
+    mask = io::read_image(mask_path);
+    in.target_mask = plane_of(mask);
+    in.target_mask_name = mask_path;
+  }
+  params.style_weight = style_weight;
+
+  synth::OutputRequest req;
+  req.nnf = !nnf_out.empty();
+  req.error = !error_out.empty();
+  synth::Result res = synth::synthesize(in, params, req);
+  const auto t1 = std::chrono::steady_clock::now();
+
+  io::WriteOptions wo;
+  if (depth == "8") wo.format = io::SampleFormat::kU8;
+  else if (depth == "16") wo.format = io::SampleFormat::kU16;
+  else if (depth == "float") wo.format = io::SampleFormat::kFloat;
+  else if (style.type() == io::PixelType::kU8) wo.format = io::SampleFormat::kU8;
+  else if (style.type() == io::PixelType::kU16) wo.format = io::SampleFormat::kU16;
+  else wo.format = io::SampleFormat::kFloat;
+  // A one-channel style whose file was RGB is written back as RGB, as EbSynth does.
+  Image<float> out_img;
+  const int ns = in.style.index() == 0 ? synth::plane_channels(in.style) : synth::plane_channels(in.style);
+  if (ns == 1 && style_path.size() && res.image.channels() <= 2) {
+    const bool alpha = res.image.channels() == 2;
+    out_img.reset(res.image.width(), res.image.height(), alpha ? 4 : 3);
+    for (int y = 0; y < res.image.height(); ++y)
+      for (int x = 0; x < res.image.width(); ++x) {
+        for (int c = 0; c < 3; ++c) out_img(x, y, c) = res.image(x, y, 0);
+        if (alpha) out_img(x, y, 3) = res.image(x, y, 1);
+      }
+  } else {
+    out_img = std::move(res.image);
+  }
+  io::write_image(output, out_img.cview(), wo);
+  if (req.nnf) {
+    Image<float> f(res.nnf.width(), res.nnf.height(), 2);
+    for (int y = 0; y < f.height(); ++y)
+      for (int x = 0; x < f.width(); ++x)
+        for (int c = 0; c < 2; ++c) f(x, y, c) = float(res.nnf(x, y, c));
+    io::WriteOptions o;
+    o.format = io::SampleFormat::kFloat;
+    o.channel_names = {"nnf.X", "nnf.Y"};
+    io::write_image(nnf_out, f.cview(), o);
+  }
+  if (req.error) {
+    io::WriteOptions o;
+    o.format = io::SampleFormat::kFloat;
+    o.channel_names = {"error.Y"};
+    io::write_image(error_out, res.error.cview(), o);
+  }
+  if (!quiet)
+    std::fprintf(stderr, "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
+                 out_img.width(), out_img.height(), style.width(), style.height(), ns,
+                 in.guides.size(), res.pyramid_levels,
+                 std::chrono::duration<double>(t1 - t0).count());
+  return 0;
+}
+
+}  // namespace emaki::app

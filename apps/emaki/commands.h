@@ -1,0 +1,23 @@
+// The emaki subcommands. Each takes its arguments (after the subcommand name) and returns the
+// process exit code; user errors are thrown as emaki::Error and printed once by main().
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace emaki::app {
+
+using Args = std::vector<std::string>;
+
+int run_synth(const Args& args);
+
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(const Args&);
+};
+
+// All subcommands, in the order `emaki --help` lists them.
+const std::vector<Command>& commands();
+
+}  // namespace emaki::app

@@ -1,0 +1,49 @@
+// emaki: parse -> load -> pipeline -> report. Only this layer decides exit codes.
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "apps/emaki/commands.h"
+#include "core/error.h"
+
+namespace emaki::app {
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> list = {
+      {"synth", "guided patch-based synthesis (EbSynth-compatible command line)", run_synth},
+  };
+  return list;
+}
+
+namespace {
+void print_usage() {
+  std::printf("emaki — stylize 3D animation by example\n\nusage: emaki <command> [options]\n\n");
+  for (const auto& c : commands()) std::printf("  %-10s %s\n", c.name, c.summary);
+  std::printf("\n'emaki <command> --help' documents a command's options.\n");
+}
+}  // namespace
+}  // namespace emaki::app
+
+int main(int argc, char** argv) {
+  using namespace emaki::app;
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+    print_usage();
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string name = argv[1];
+  Args args(argv + 2, argv + argc);
+  for (const auto& c : commands()) {
+    if (name != c.name) continue;
+    try {
+      return c.run(args);
+    } catch (const emaki::Error& e) {
+      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, e.what());
+      return 1;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, e.what());
+      return 1;
+    }
+  }
+  std::fprintf(stderr, "emaki: error: unknown command '%s' (see 'emaki --help')\n", name.c_str());
+  return 2;
+}

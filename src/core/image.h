@@ -1,0 +1,114 @@
+// Image<T>: an owning, interleaved image with any channel count whose rows are aligned and
+// padded to 64 bytes, so SIMD row loads are aligned and threads writing different rows never
+// share a cache line (after highway's contrib/image). ImageView<T>: the non-owning (pointer,
+// size, stride) window that algorithms take (after OpenImageIO). Images are move-only; copies
+// are explicit (clone()).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <type_traits>
+#include <utility>
+
+#include "core/check.h"
+
+namespace emaki {
+
+inline constexpr std::size_t kRowAlign = 64;
+
+template <typename T>
+struct ImageView {
+  T* data = nullptr;
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::ptrdiff_t stride = 0;  // elements between the starts of consecutive rows
+
+  T* row(int y) const { return data + y * stride; }
+  T* at(int x, int y) const { return data + y * stride + std::ptrdiff_t(x) * channels; }
+  T& operator()(int x, int y, int c = 0) const { return at(x, y)[c]; }
+  bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
+  operator ImageView<const T>() const
+    requires(!std::is_const_v<T>)
+  {
+    return {data, width, height, channels, stride};
+  }
+};
+
+template <typename T>
+class Image {
+ public:
+  Image() = default;
+  Image(int width, int height, int channels) { reset(width, height, channels); }
+  Image(const Image&) = delete;
+  Image& operator=(const Image&) = delete;
+  Image(Image&& o) noexcept { *this = std::move(o); }
+  Image& operator=(Image&& o) noexcept {
+    mem_ = std::move(o.mem_);
+    width_ = std::exchange(o.width_, 0);
+    height_ = std::exchange(o.height_, 0);
+    channels_ = std::exchange(o.channels_, 0);
+    stride_ = std::exchange(o.stride_, 0);
+    return *this;
+  }
+
+  // Allocates zero-filled storage (zero so that row padding is deterministic too).
+  void reset(int width, int height, int channels) {
+    CHECK_GE(width, 0);
+    CHECK_GE(height, 0);
+    CHECK_GT(channels, 0);
+    width_ = width;
+    height_ = height;
+    channels_ = channels;
+    const std::size_t row_bytes = std::size_t(width) * channels * sizeof(T);
+    const std::size_t padded = (row_bytes + kRowAlign - 1) / kRowAlign * kRowAlign;
+    stride_ = std::ptrdiff_t(padded / sizeof(T));
+    const std::size_t bytes = std::max<std::size_t>(padded * height, kRowAlign);
+    mem_.reset(static_cast<T*>(std::aligned_alloc(kRowAlign, bytes)));
+    CHECK(mem_ != nullptr);
+    std::memset(mem_.get(), 0, bytes);
+  }
+
+  Image clone() const {
+    Image out(width_, height_, channels_);
+    if (height_ > 0) std::memcpy(out.mem_.get(), mem_.get(), bytes());
+    return out;
+  }
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int channels() const { return channels_; }
+  std::ptrdiff_t stride() const { return stride_; }
+  std::size_t bytes() const { return std::size_t(stride_) * height_ * sizeof(T); }
+  bool empty() const { return width_ == 0 || height_ == 0; }
+
+  T* row(int y) { return mem_.get() + y * stride_; }
+  const T* row(int y) const { return mem_.get() + y * stride_; }
+  T* at(int x, int y) { return row(y) + std::ptrdiff_t(x) * channels_; }
+  const T* at(int x, int y) const { return row(y) + std::ptrdiff_t(x) * channels_; }
+  T& operator()(int x, int y, int c = 0) { return at(x, y)[c]; }
+  const T& operator()(int x, int y, int c = 0) const { return at(x, y)[c]; }
+
+  ImageView<T> view() { return {mem_.get(), width_, height_, channels_, stride_}; }
+  ImageView<const T> view() const { return {mem_.get(), width_, height_, channels_, stride_}; }
+  ImageView<const T> cview() const { return view(); }
+
+  void fill(T v) {
+    for (int y = 0; y < height_; ++y) std::fill(row(y), row(y) + std::size_t(width_) * channels_, v);
+  }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  std::unique_ptr<T, Free> mem_;
+  int width_ = 0, height_ = 0, channels_ = 0;
+  std::ptrdiff_t stride_ = 0;
+};
+
+using ImageF = Image<float>;
+
+}  // namespace emaki

@@ -1,0 +1,55 @@
+#include "core/parallel.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <memory>
+#include <mutex>
+
+namespace emaki {
+namespace {
+std::mutex g_mutex;
+int g_threads = 0;
+std::unique_ptr<tbb::task_arena> g_arena;
+
+tbb::task_arena& arena() {
+  std::lock_guard lock(g_mutex);
+  if (!g_arena) {
+    const int n = g_threads > 0 ? g_threads : tbb::this_task_arena::max_concurrency();
+    g_arena = std::make_unique<tbb::task_arena>(n);
+  }
+  return *g_arena;
+}
+}  // namespace
+
+void set_thread_count(int n) {
+  std::lock_guard lock(g_mutex);
+  g_threads = std::max(0, n);
+  g_arena.reset();
+}
+
+int thread_count() { return arena().max_concurrency(); }
+
+void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn) {
+  if (n <= 0) return;
+  grain = std::max<int64_t>(1, grain);
+  const int64_t chunks = (n + grain - 1) / grain;
+  if (chunks == 1) {
+    fn(0, n);
+    return;
+  }
+  arena().execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<int64_t>(0, chunks, 1),
+        [&](const tbb::blocked_range<int64_t>& r) {
+          for (int64_t c = r.begin(); c != r.end(); ++c) fn(c * grain, std::min(n, (c + 1) * grain));
+        },
+        tbb::simple_partitioner());
+  });
+}
+
+}  // namespace emaki

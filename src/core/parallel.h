@@ -1,0 +1,22 @@
+// Parallel loops. Work is cut into chunks whose boundaries depend only on the problem size
+// (never on the thread count), so any per-chunk state gives the same result for 1 or N threads.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+namespace emaki {
+
+// Sets the number of worker threads used by parallel_for (0 = all hardware threads).
+void set_thread_count(int n);
+int thread_count();
+
+// Calls fn(begin, end) over [0, n) in chunks of `grain` items, in parallel.
+void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn);
+
+// Calls fn(y0, y1) over row bands of `band` rows.
+inline void parallel_rows(int height, int band, const std::function<void(int, int)>& fn) {
+  parallel_for(height, band, [&](int64_t a, int64_t b) { fn(int(a), int(b)); });
+}
+
+}  // namespace emaki

@@ -1,0 +1,68 @@
+// Image files through OpenImageIO: PNG 8/16-bit, EXR half/float (channels picked by name from
+// multilayer files), TIFF, JPEG. Images come back in their file's precision (8-bit, 16-bit or
+// float), so an 8-bit guide costs one byte per sample in memory and a float guide keeps all of
+// its precision. Every write is atomic: a temporary file in the same folder, then a rename.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/image.h"
+
+namespace emaki::io {
+
+enum class PixelType { kU8, kU16, kF32 };
+
+// An image as stored in its file: 8-bit, 16-bit or float samples (half is read as float).
+struct AnyImage {
+  std::variant<Image<uint8_t>, Image<uint16_t>, Image<float>> image;
+  std::vector<std::string> channel_names;
+
+  int width() const;
+  int height() const;
+  int channels() const;
+  PixelType type() const;
+  // Sample (x, y, c) normalised to [0, 1] for integer types, as-is for float.
+  float value(int x, int y, int c) const;
+  // Converts to float (integer types normalised to [0, 1]).
+  Image<float> to_float() const;
+  // Keeps only channels [first, first + count).
+  AnyImage select_channels(int first, int count) const;
+};
+
+struct ReadOptions {
+  // Channel names to pick, in order (e.g. {"position.X","position.Y","position.Z"}); empty reads
+  // all channels. Names are searched in every part (subimage) of a multilayer file.
+  std::vector<std::string> channels;
+};
+
+// Throws emaki::Error naming the file on a missing, unreadable or corrupt file, or a channel
+// that is not in it (the message lists the channels the file has).
+AnyImage read_image(const std::string& path, const ReadOptions& options = {});
+Image<float> read_image_float(const std::string& path, const ReadOptions& options = {});
+
+// Lists the channel names of every part of a file.
+std::vector<std::string> list_channels(const std::string& path);
+
+enum class SampleFormat { kAuto, kU8, kU16, kHalf, kFloat };
+
+struct WriteOptions {
+  // kAuto: 16-bit for PNG/TIFF, half for EXR, 8-bit for JPEG.
+  SampleFormat format = SampleFormat::kAuto;
+  std::vector<std::string> channel_names;  // EXR channel names; default R,G,B,A / Y
+};
+
+// Writes a float image (values in [0,1] for integer formats, clamped and rounded). Atomic.
+void write_image(const std::string& path, ImageView<const float> image,
+                 const WriteOptions& options = {});
+
+// True when the file extension names a format we can write.
+bool is_writable_extension(const std::string& path);
+
+// Checks early (before any long computation) that `path` can be written: its folder exists and
+// is writable and its extension names an image format. Throws emaki::Error naming the path.
+void check_writable(const std::string& path);
+
+}  // namespace emaki::io

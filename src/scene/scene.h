@@ -1,0 +1,183 @@
+// The in-memory Scene: a glTF 2.0-shaped node hierarchy with triangle meshes, skins, morph
+// targets, materials, cameras and animation clips, plus the evaluation of a clip at a time into
+// posed world-space geometry. Nothing here reads files (io/gltf_loader fills a Scene).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "core/image.h"
+
+namespace emaki::scene {
+
+// A decoded texture: linear-light RGBA float (sRGB-encoded colour textures are decoded on load).
+struct Texture {
+  enum class Wrap { kRepeat, kClamp, kMirror };
+  Image<float> rgba;  // 4 channels
+  Wrap wrap_s = Wrap::kRepeat;
+  Wrap wrap_t = Wrap::kRepeat;
+};
+
+struct Material {
+  std::string name;
+  glm::vec4 base_color{1.0f};  // linear RGBA factor
+  int base_color_texture = -1;  // index into Scene::textures, -1: none
+  int texcoord = 0;             // which UV set the texture reads (only set 0 is kept)
+};
+
+struct MorphTarget {
+  std::vector<glm::vec3> positions;  // displacements, one per vertex (may be empty)
+  std::vector<glm::vec3> normals;    // displacements, one per vertex (may be empty)
+};
+
+// One indexed triangle list with its vertex attributes; all per-vertex arrays have the same
+// length as positions (or are empty when the file has no such attribute).
+struct Primitive {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<glm::u16vec4> joints;  // indices into the node's Skin::joints
+  std::vector<glm::vec4> weights;
+  std::vector<uint32_t> indices;  // 3 per triangle
+  std::vector<MorphTarget> targets;
+  int material = -1;  // index into Scene::materials, -1: the default material
+};
+
+struct Mesh {
+  std::string name;
+  std::vector<Primitive> primitives;
+  std::vector<float> weights;  // default morph weights
+};
+
+struct Skin {
+  std::string name;
+  std::vector<int> joints;  // node indices
+  std::vector<glm::mat4> inverse_bind;  // one per joint
+};
+
+struct CameraDef {
+  std::string name;
+  bool perspective = true;
+  float yfov = 0.8f;  // radians (perspective)
+  float xmag = 1.0f, ymag = 1.0f;  // half extents (orthographic)
+  float znear = 0.01f;
+};
+
+struct Node {
+  std::string name;
+  int parent = -1;
+  std::vector<int> children;
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // w, x, y, z
+  glm::vec3 scale{1.0f};
+  // A node given by a matrix is not animatable (glTF rule); the matrix replaces T*R*S.
+  bool has_matrix = false;
+  glm::mat4 matrix{1.0f};
+  int mesh = -1;
+  int skin = -1;
+  int camera = -1;
+  std::vector<float> weights;  // morph weights overriding the mesh's defaults
+};
+
+enum class AnimPath { kTranslation, kRotation, kScale, kWeights };
+enum class Interpolation { kLinear, kStep, kCubicSpline };
+
+struct AnimSampler {
+  std::vector<float> times;   // strictly increasing keyframe times (seconds)
+  std::vector<float> values;  // components per key (x3 for cubic spline: in, value, out)
+  int components = 0;         // 3, 4 or the morph target count
+  Interpolation interpolation = Interpolation::kLinear;
+};
+
+struct AnimChannel {
+  int node = -1;
+  AnimPath path = AnimPath::kTranslation;
+  int sampler = -1;
+};
+
+struct Animation {
+  std::string name;
+  std::vector<AnimSampler> samplers;
+  std::vector<AnimChannel> channels;
+  float start = 0.0f;  // earliest key time
+  float end = 0.0f;    // latest key time
+};
+
+struct Scene {
+  std::vector<Node> nodes;
+  std::vector<int> roots;  // the nodes of the displayed glTF scene
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Skin> skins;
+  std::vector<CameraDef> cameras;
+  std::vector<Animation> animations;
+
+  // Index of the clip called `name`, or -1.
+  int find_animation(const std::string& name) const;
+};
+
+// Samples one animation sampler at time t (clamped to its key range) into out[components].
+// Rotations (components == 4 with slerp) are normalised quaternions stored x, y, z, w.
+void sample(const AnimSampler& s, float t, bool is_rotation, float* out);
+
+// Local transforms, world matrices and morph weights of every node at one time.
+struct Pose {
+  std::vector<glm::vec3> translation;
+  std::vector<glm::quat> rotation;
+  std::vector<glm::vec3> scale;
+  std::vector<std::vector<float>> weights;  // per node; empty: the mesh defaults
+  std::vector<glm::mat4> world;
+};
+
+// Evaluates clip `animation` (-1: the rest pose as stored in the nodes) at time t.
+Pose evaluate_pose(const Scene& scene, int animation, float t);
+
+// One drawn mesh primitive posed at one time. object_id counts the drawn (node, mesh) pairs in
+// hierarchy order from 0; material is the Scene material index (-1: default).
+struct PosedPrimitive {
+  int node = -1;
+  int mesh = -1;
+  int primitive = -1;
+  int object_id = 0;
+  int material = -1;
+  std::vector<glm::vec3> world_positions;
+  std::vector<glm::vec3> world_normals;  // unit length
+  const std::vector<glm::vec3>* rest_positions = nullptr;  // object space, bind pose
+  const std::vector<glm::vec2>* uvs = nullptr;              // may be empty
+  const std::vector<uint32_t>* indices = nullptr;
+};
+
+struct PosedScene {
+  std::vector<PosedPrimitive> primitives;
+  int object_count = 0;
+};
+
+// The world-space geometry of every mesh instance at time t of clip `animation` (-1: rest):
+// node transforms, skinning (4 weights per vertex) and morph targets applied.
+PosedScene pose_scene(const Scene& scene, int animation, float t);
+
+struct Bounds {
+  glm::vec3 lo{1e30f};
+  glm::vec3 hi{-1e30f};
+  bool empty() const { return lo.x > hi.x; }
+  void add(const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void add(const Bounds& b) {
+    if (!b.empty()) add(b.lo), add(b.hi);
+  }
+  glm::vec3 center() const { return 0.5f * (lo + hi); }
+  glm::vec3 size() const { return hi - lo; }
+};
+
+Bounds world_bounds(const PosedScene& posed);
+// Bounds of the rest (bind-pose, object-space) positions of every drawn primitive.
+Bounds rest_bounds(const PosedScene& posed);
+
+}  // namespace emaki::scene

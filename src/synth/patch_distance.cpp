@@ -1,0 +1,36 @@
+#include "synth/patch_distance.h"
+
+#include <cstdlib>
+#include <cstring>
+
+namespace emaki::synth {
+
+int64_t patch_ssd_scalar(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                         std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound) {
+  int64_t sum = 0;
+  for (int j = 0; j < rows; ++j) {
+    const int16_t* pa = a + j * a_stride;
+    const int16_t* pb = b + j * b_stride;
+    int64_t row = 0;
+    for (int i = 0; i < row_elems; ++i) {
+      const int32_t d = int32_t(pa[i]) - int32_t(pb[i]);
+      row += int64_t(d) * d;
+    }
+    sum += row;
+    if (sum > bound) break;
+  }
+  return sum;
+}
+
+bool cpu_has_avx2() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+}
+
+PatchSsdFn best_patch_ssd() {
+  const char* force = std::getenv("EMAKI_SIMD");
+  if (force && std::strcmp(force, "scalar") == 0) return patch_ssd_scalar;
+  return cpu_has_avx2() ? patch_ssd_avx2 : patch_ssd_scalar;
+}
+
+}  // namespace emaki::synth

@@ -1,0 +1,63 @@
+// AVX2 patch distance. Compiled with -mavx2; only called when the CPU has AVX2.
+// Differences of int16 values in [0, 16383] fit int16; madd_epi16 sums two squares into an
+// int32 (<= 2 * 16383^2); three such sums still fit an int32 lane, so lanes are widened to
+// int64 every three chunks and the total is exact.
+#include <immintrin.h>
+
+#include "synth/patch_distance.h"
+
+namespace emaki::synth {
+
+namespace {
+inline __m256i widen_add(__m256i acc64, __m256i v32) {
+  const __m256i lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(v32));
+  const __m256i hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(v32, 1));
+  return _mm256_add_epi64(acc64, _mm256_add_epi64(lo, hi));
+}
+inline int64_t hsum64(__m256i v) {
+  const __m128i s = _mm_add_epi64(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+  return _mm_cvtsi128_si64(s) + _mm_extract_epi64(s, 1);
+}
+}  // namespace
+
+int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                       std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound) {
+  __m256i acc64 = _mm256_setzero_si256();
+  for (int j = 0; j < rows; ++j) {
+    const int16_t* pa = a + j * a_stride;
+    const int16_t* pb = b + j * b_stride;
+    __m256i acc32 = _mm256_setzero_si256();
+    int pending = 0;
+    int i = 0;
+    for (; i + 16 <= row_elems; i += 16) {
+      const __m256i va = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pa + i));
+      const __m256i vb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pb + i));
+      const __m256i d = _mm256_sub_epi16(va, vb);
+      acc32 = _mm256_add_epi32(acc32, _mm256_madd_epi16(d, d));
+      if (++pending == 3) {
+        acc64 = widen_add(acc64, acc32);
+        acc32 = _mm256_setzero_si256();
+        pending = 0;
+      }
+    }
+    if (i < row_elems) {  // an 8-element tail
+      const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pa + i));
+      const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + i));
+      const __m128i d = _mm_sub_epi16(va, vb);
+      const __m256i sq = _mm256_zextsi128_si256(_mm_madd_epi16(d, d));
+      if (pending == 3) {
+        acc64 = widen_add(acc64, acc32);
+        acc32 = _mm256_setzero_si256();
+      }
+      acc32 = _mm256_add_epi32(acc32, sq);
+    }
+    acc64 = widen_add(acc64, acc32);
+    if (rows > 1 && j + 1 < rows) {
+      const int64_t s = hsum64(acc64);
+      if (s > bound) return s;
+    }
+  }
+  return hsum64(acc64);
+}
+
+}  // namespace emaki::synth

@@ -1,0 +1,239 @@
+#include "synth/patch_match.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <mutex>
+#include <vector>
+
+#include "core/check.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+
+namespace emaki::synth {
+
+namespace {
+
+inline bool is_active(const PatchMatchLevel& L, int x, int y) {
+  return L.active == nullptr || L.active->empty() || (*L.active)(x, y) != 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Occupancy
+
+// Adds sign * (p - |dx|) * (p - |dy|) around source centre (cx, cy): the change of the window
+// sums when one target patch starts or stops covering the patch at that centre.
+void add_triangle(int32_t* buf, int sw, int sh, int cx, int cy, int p, int sign) {
+  const int reach = p - 1;
+  const int y0 = std::max(0, cy - reach), y1 = std::min(sh - 1, cy + reach);
+  const int x0 = std::max(0, cx - reach), x1 = std::min(sw - 1, cx + reach);
+  for (int y = y0; y <= y1; ++y) {
+    const int wy = sign * (p - std::abs(y - cy));
+    int32_t* row = buf + std::ptrdiff_t(y) * sw;
+    for (int x = x0; x <= x1; ++x) row[x] += wy * (p - std::abs(x - cx));
+  }
+}
+
+// A band-private occupancy delta, zero between uses. Pooled so that a sweep allocates no
+// source-sized buffers; which buffer a band gets does not matter since each starts at zero.
+class DeltaPool {
+ public:
+  explicit DeltaPool(std::size_t n) : n_(n) {}
+  std::vector<int32_t> take() {
+    std::lock_guard lock(mutex_);
+    if (free_.empty()) return std::vector<int32_t>(n_, 0);
+    auto v = std::move(free_.back());
+    free_.pop_back();
+    return v;
+  }
+  void give(std::vector<int32_t>&& v) {
+    std::lock_guard lock(mutex_);
+    free_.push_back(std::move(v));
+  }
+
+ private:
+  std::size_t n_;
+  std::mutex mutex_;
+  std::vector<std::vector<int32_t>> free_;
+};
+
+struct Sweep {
+  const PatchMatchLevel& L;
+  const PatchMatchConfig& C;
+  const int32_t* occ;        // snapshot window sums, sw x sh
+  const Image<int32_t>& snap;  // field at the start of the sweep
+  float occ_scale;           // uniformity / (p^2 * omega_best)
+  int r;
+  std::ptrdiff_t src_stride, tgt_stride;
+  int row_elems;
+};
+
+struct Band {
+  int32_t* delta;
+  std::vector<int32_t> changes;  // (centre index, sign) pairs to undo the delta afterwards
+};
+
+inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int cy) {
+  const PatchMatchLevel& L = S.L;
+  int32_t* n = L.nnf->at(x, y);
+  if (cx == n[0] && cy == n[1]) return;
+  const std::ptrdiff_t ci = std::ptrdiff_t(n[1]) * L.sw + n[0];
+  const std::ptrdiff_t ni = std::ptrdiff_t(cy) * L.sw + cx;
+  const float cur_occ = S.occ_scale * float(S.occ[ci] + band.delta[ci]);
+  const float new_occ = S.occ_scale * float(S.occ[ni] + band.delta[ni]);
+  float& e = (*L.err)(x, y);
+  const float cur_cost = e + cur_occ;
+  const float bound = cur_cost - new_occ;
+  if (!(bound > 0.0f)) return;
+  const double bq = std::floor(double(bound) / S.C.err_scale);
+  const int64_t bound_q = bq > 9.0e18 ? std::numeric_limits<int64_t>::max() : int64_t(bq);
+  const int16_t* t = L.tgt->at(x + L.border - S.r, y + L.border - S.r);
+  const int16_t* s = L.src->at(cx - S.r, cy - S.r);
+  const int64_t ssd = S.C.ssd(t, S.tgt_stride, s, S.src_stride, S.row_elems, 2 * S.r + 1, bound_q);
+  if (ssd > bound_q) return;
+  const float new_err = float(double(ssd) * S.C.err_scale);
+  if (!(new_err + new_occ < cur_cost)) return;
+  if (S.occ_scale > 0.0f) {
+    const int p = 2 * S.r + 1;
+    add_triangle(band.delta, L.sw, L.sh, n[0], n[1], p, -1);
+    add_triangle(band.delta, L.sw, L.sh, cx, cy, p, +1);
+    band.changes.insert(band.changes.end(), {n[0], n[1], -1, cx, cy, +1});
+  }
+  n[0] = cx;
+  n[1] = cy;
+  e = new_err;
+}
+
+void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
+  const PatchMatchLevel& L = S.L;
+  const bool forward = (iter % 2) == 0;
+  const int q = forward ? 1 : -1;
+  const int r = S.r;
+  const int lo_x = r, hi_x = L.sw - r - 1, lo_y = r, hi_y = L.sh - r - 1;
+  const int max_rad = S.C.max_search_radius > 0 ? S.C.max_search_radius : std::max(L.sw, L.sh);
+  const int ys = forward ? y0 : y1 - 1, ye = forward ? y1 : y0 - 1;
+  const int xs = forward ? 0 : L.tw - 1, xe = forward ? L.tw : -1;
+  for (int y = ys; y != ye; y += q) {
+    for (int x = xs; x != xe; x += q) {
+      if (!is_active(L, x, y)) continue;
+      // Propagation from the neighbour already visited in this sweep's direction.
+      const int nx = x - q;
+      if (nx >= 0 && nx < L.tw && is_active(L, nx, y)) {
+        const int32_t* m = L.nnf->at(nx, y);
+        const int cx = m[0] + q;
+        if (cx >= lo_x && cx <= hi_x) try_candidate(S, band, x, y, cx, m[1]);
+      }
+      const int ny = y - q;
+      if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
+        // Across the band edge, read the field as it was when the sweep began.
+        const bool inside = ny >= y0 && ny < y1;
+        const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, ny);
+        const int cy = m[1] + q;
+        if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy);
+      }
+      // Random search in windows halving around the current best.
+      CounterRng rng(hash_key(S.C.seed, uint64_t(iter), uint64_t(y) * 65536u + uint64_t(x)));
+      for (int rad = max_rad; rad >= 1; rad /= 2) {
+        const int32_t* m = L.nnf->at(x, y);
+        const int wx0 = std::max(lo_x, m[0] - rad), wx1 = std::min(hi_x, m[0] + rad);
+        const int wy0 = std::max(lo_y, m[1] - rad), wy1 = std::min(hi_y, m[1] + rad);
+        const int cx = wx0 + int(rng.uniform(uint32_t(wx1 - wx0 + 1)));
+        const int cy = wy0 + int(rng.uniform(uint32_t(wy1 - wy0 + 1)));
+        try_candidate(S, band, x, y, cx, cy);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<int32_t> occupancy_window_sums(const PatchMatchLevel& L, int p) {
+  // Histogram of patch centres, then a separable triangle filter (p - |d|, |d| < p).
+  Image<int32_t> count(L.sw, L.sh, 1);
+  for (int y = 0; y < L.th; ++y)
+    for (int x = 0; x < L.tw; ++x)
+      if (is_active(L, x, y)) {
+        const int32_t* m = L.nnf->at(x, y);
+        count(m[0], m[1]) += 1;
+      }
+  Image<int32_t> tmp(L.sw, L.sh, 1);
+  parallel_rows(L.sh, 64, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < L.sw; ++x) {
+        int32_t s = 0;
+        for (int d = -(p - 1); d <= p - 1; ++d) {
+          const int xx = x + d;
+          if (xx >= 0 && xx < L.sw) s += (p - std::abs(d)) * count(xx, y);
+        }
+        tmp(x, y) = s;
+      }
+  });
+  std::vector<int32_t> out(std::size_t(L.sw) * L.sh);
+  parallel_rows(L.sh, 64, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < L.sw; ++x) {
+        int32_t s = 0;
+        for (int d = -(p - 1); d <= p - 1; ++d) {
+          const int yy = y + d;
+          if (yy >= 0 && yy < L.sh) s += (p - std::abs(d)) * tmp(x, yy);
+        }
+        out[std::size_t(y) * L.sw + x] = s;
+      }
+  });
+  return out;
+}
+
+void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
+  const int r = C.patch_size / 2;
+  const int row_elems = C.patch_size * L.src->channels();
+  parallel_rows(L.th, kBandRows, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < L.tw; ++x) {
+        if (!is_active(L, x, y)) {
+          (*L.err)(x, y) = 0.0f;
+          continue;
+        }
+        const int32_t* m = L.nnf->at(x, y);
+        const int64_t ssd = C.ssd(L.tgt->at(x + L.border - r, y + L.border - r), L.tgt->stride(),
+                                  L.src->at(m[0] - r, m[1] - r), L.src->stride(), row_elems,
+                                  C.patch_size, std::numeric_limits<int64_t>::max());
+        (*L.err)(x, y) = float(double(ssd) * C.err_scale);
+      }
+  });
+}
+
+void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
+  CHECK(C.ssd != nullptr);
+  CHECK_EQ(C.patch_size % 2, 1);
+  const int p = C.patch_size;
+  int64_t active_count = 0;
+  for (int y = 0; y < L.th; ++y)
+    for (int x = 0; x < L.tw; ++x) active_count += is_active(L, x, y) ? 1 : 0;
+  if (active_count == 0) return;
+  const double omega_best = double(active_count) / (double(L.sw) * L.sh) * p * p;
+  const float occ_scale = C.uniformity > 0.0f ? float(C.uniformity / (double(p) * p * omega_best)) : 0.0f;
+
+  DeltaPool pool(std::size_t(L.sw) * L.sh);
+  Image<int32_t> snap(L.tw, L.th, 2);
+  for (int iter = 0; iter < C.iterations; ++iter) {
+    std::memcpy(snap.row(0), L.nnf->row(0), L.nnf->bytes());
+    const std::vector<int32_t> occ = occ_scale > 0.0f ? occupancy_window_sums(L, p)
+                                                      : std::vector<int32_t>(std::size_t(L.sw) * L.sh, 0);
+    const Sweep sweep{L, C, occ.data(), snap, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
+                      p * L.src->channels()};
+    parallel_rows(L.th, kBandRows, [&](int y0, int y1) {
+      Band band;
+      auto buf = pool.take();
+      band.delta = buf.data();
+      sweep_band(sweep, band, y0, y1, iter);
+      // Undo this band's changes so the buffer goes back to the pool zeroed.
+      for (std::size_t i = 0; i < band.changes.size(); i += 3)
+        add_triangle(band.delta, L.sw, L.sh, band.changes[i], band.changes[i + 1], p,
+                     -band.changes[i + 2]);
+      pool.give(std::move(buf));
+    });
+  }
+}
+
+}  // namespace emaki::synth

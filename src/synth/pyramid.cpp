@@ -1,0 +1,81 @@
+#include "synth/pyramid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel.h"
+
+namespace emaki::synth {
+
+namespace {
+
+template <typename T>
+Image<T> downsample_impl(ImageView<const T> in) {
+  const int w = in.width, h = in.height, c = in.channels;
+  const int ow = half_size(w), oh = half_size(h);
+  // Horizontal pass into float, then vertical pass.
+  Image<float> tmp(ow, h, c);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < ow; ++x) {
+        const int xs[4] = {std::clamp(2 * x - 1, 0, w - 1), std::min(2 * x, w - 1),
+                           std::min(2 * x + 1, w - 1), std::min(2 * x + 2, w - 1)};
+        for (int k = 0; k < c; ++k)
+          tmp(x, y, k) = (float(in(xs[0], y, k)) + 3.0f * float(in(xs[1], y, k)) +
+                          3.0f * float(in(xs[2], y, k)) + float(in(xs[3], y, k))) *
+                         0.125f;
+      }
+  });
+  Image<T> out(ow, oh, c);
+  parallel_rows(oh, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const int ys[4] = {std::clamp(2 * y - 1, 0, h - 1), std::min(2 * y, h - 1),
+                         std::min(2 * y + 1, h - 1), std::min(2 * y + 2, h - 1)};
+      for (int x = 0; x < ow; ++x)
+        for (int k = 0; k < c; ++k) {
+          const float v = (tmp(x, ys[0], k) + 3.0f * tmp(x, ys[1], k) + 3.0f * tmp(x, ys[2], k) +
+                           tmp(x, ys[3], k)) *
+                          0.125f;
+          if constexpr (std::is_integral_v<T>) out(x, y, k) = T(std::lround(v));
+          else out(x, y, k) = v;
+        }
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
+Image<float> downsample(ImageView<const float> in) { return downsample_impl(in); }
+Image<int16_t> downsample(ImageView<const int16_t> in) { return downsample_impl(in); }
+
+Image<uint8_t> downsample_mask(ImageView<const uint8_t> in) {
+  const int ow = half_size(in.width), oh = half_size(in.height);
+  Image<uint8_t> out(ow, oh, 1);
+  for (int y = 0; y < oh; ++y)
+    for (int x = 0; x < ow; ++x) {
+      uint8_t v = 0;
+      for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx)
+          v |= in(std::min(2 * x + dx, in.width - 1), std::min(2 * y + dy, in.height - 1));
+      out(x, y) = v;
+    }
+  return out;
+}
+
+void pad_replicate(Image<int16_t>& im, int b, int c0, int c1) {
+  const int w = im.width() - 2 * b, h = im.height() - 2 * b;
+  for (int y = 0; y < im.height(); ++y) {
+    const int sy = std::clamp(y, b, b + h - 1);
+    for (int x = 0; x < im.width(); ++x) {
+      if (y >= b && y < b + h && x >= b && x < b + w) {
+        x = b + w - 1;  // skip the interior
+        continue;
+      }
+      const int sx = std::clamp(x, b, b + w - 1);
+      for (int k = c0; k < c1; ++k) im(x, y, k) = im(sx, sy, k);
+    }
+  }
+}
+
+}  // namespace emaki::synth

@@ -1,0 +1,65 @@
+// Feature images and the image pyramid.
+//
+// A feature pixel interleaves the style channels then the guide channels as int16, padded with
+// zeros to a multiple of 8 so that a patch row is a whole number of 128-bit lanes. Each channel
+// is mapped q = round((v - lo) * mult) with mult = 16383 * sqrt(w / w_max) / range, so the
+// squared difference of q values is the weighted squared difference of v, up to one global
+// factor (err_scale) — weights cost nothing in the distance kernel.
+//
+// Pyramid levels halve with a [1 3 3 1] / 8 low-pass filter (EbSynth samples bilinearly without
+// a low-pass, which lets thin lines alias away at coarse levels).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/image.h"
+
+namespace emaki::synth {
+
+inline constexpr int kQuantMax = 16383;
+
+struct ChannelMap {
+  float lo = 0.0f;    // value mapped to 0
+  float mult = 0.0f;  // levels per unit of value
+  int16_t quantize(float v) const {
+    float q = (v - lo) * mult + 0.5f;
+    q = q < 0.0f ? 0.0f : (q > float(kQuantMax) ? float(kQuantMax) : q);
+    return int16_t(q);
+  }
+};
+
+struct FeatureLayout {
+  int style_channels = 0;
+  int guide_channels = 0;
+  int channels = 0;  // padded to a multiple of 8
+  std::vector<ChannelMap> map;  // style then guide channels
+  double err_scale = 1.0;       // EbSynth error = err_scale * sum of squared q differences
+};
+
+// Output size of one halving step.
+inline int half_size(int n) { return (n + 1) / 2; }
+
+// Low-pass and halve (any channel count). Integer types round to nearest.
+Image<float> downsample(ImageView<const float> in);
+Image<int16_t> downsample(ImageView<const int16_t> in);
+// A mask halves to "any child inside".
+Image<uint8_t> downsample_mask(ImageView<const uint8_t> in);
+
+// Fills the `border`-pixel frame of an image from its interior (clamp to edge), for channels
+// [c0, c1).
+void pad_replicate(Image<int16_t>& padded, int border, int c0, int c1);
+
+// The interior view of a padded image.
+template <typename T>
+ImageView<T> interior(Image<T>& padded, int border) {
+  auto v = padded.view();
+  return {v.at(border, border), v.width - 2 * border, v.height - 2 * border, v.channels, v.stride};
+}
+template <typename T>
+ImageView<const T> interior(const Image<T>& padded, int border) {
+  auto v = padded.view();
+  return {v.at(border, border), v.width - 2 * border, v.height - 2 * border, v.channels, v.stride};
+}
+
+}  // namespace emaki::synth

@@ -1,0 +1,437 @@
+#include "synth/synthesizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "core/check.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "synth/patch_match.h"
+#include "synth/pyramid.h"
+#include "synth/voting.h"
+
+namespace emaki::synth {
+
+// ---------------------------------------------------------------------------------------------
+// Planes
+
+int plane_width(const Plane& p) {
+  return std::visit([](const auto& v) { return v.width; }, p);
+}
+int plane_height(const Plane& p) {
+  return std::visit([](const auto& v) { return v.height; }, p);
+}
+int plane_channels(const Plane& p) {
+  return std::visit([](const auto& v) { return v.channels; }, p);
+}
+
+namespace {
+
+bool is_float(const Plane& p) { return p.index() == 2; }
+
+template <typename T>
+inline float norm(T v) {
+  if constexpr (std::is_same_v<T, uint8_t>) return float(v) * (1.0f / 255.0f);
+  else if constexpr (std::is_same_v<T, uint16_t>) return float(v) * (1.0f / 65535.0f);
+  else return float(v);
+}
+
+// Calls fn(x, y, const float* values) per row as normalised floats.
+template <typename Fn>
+void for_each_row(const Plane& plane, int y0, int y1, Fn&& fn) {
+  std::visit(
+      [&](const auto& v) {
+        std::vector<float> row(std::size_t(v.width) * v.channels);
+        for (int y = y0; y < y1; ++y) {
+          const auto* s = v.row(y);
+          for (std::size_t i = 0; i < row.size(); ++i) row[i] = norm(s[i]);
+          fn(y, row.data());
+        }
+      },
+      plane);
+}
+
+void plane_range(const Plane& p, int c, float& lo, float& hi) {
+  for_each_row(p, 0, plane_height(p), [&](int, const float* row) {
+    const int nc = plane_channels(p);
+    for (int x = 0; x < plane_width(p); ++x) {
+      lo = std::min(lo, row[x * nc + c]);
+      hi = std::max(hi, row[x * nc + c]);
+    }
+  });
+}
+
+void check_finite(const Plane& p, const std::string& name) {
+  if (!is_float(p)) return;
+  const auto& v = std::get<2>(p);
+  for (int y = 0; y < v.height; ++y)
+    for (int i = 0; i < v.width * v.channels; ++i)
+      if (!std::isfinite(v.row(y)[i]))
+        throw Error(name, fmt::format("non-finite value (NaN or Inf) at pixel ({}, {})",
+                                      i / v.channels, y));
+}
+
+float guide_weight(const GuidePair& g, std::size_t count) {
+  return g.weight < 0.0f ? 1.0f / float(count) : g.weight;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Validation and schedule
+
+int max_pyramid_levels(int sw, int sh, int tw, int th, int patch_size) {
+  int levels = 1;
+  int a = sw, b = sh, c = tw, d = th;
+  for (;;) {
+    a = half_size(a), b = half_size(b), c = half_size(c), d = half_size(d);
+    if (std::min({a, b, c, d}) < 2 * patch_size + 1) break;
+    ++levels;
+  }
+  return levels;
+}
+
+void validate(const Inputs& in, const Params& p) {
+  if (p.patch_size < 3 || p.patch_size % 2 == 0)
+    throw Error("patch size", fmt::format("must be odd and >= 3 (got {})", p.patch_size));
+  if (!(p.uniformity >= 0.0f) || !std::isfinite(p.uniformity))
+    throw Error("uniformity", "must be a finite number >= 0");
+  if (p.pyramid_levels == 0 || p.pyramid_levels < -1)
+    throw Error("pyramid levels", fmt::format("must be >= 1 (got {})", p.pyramid_levels));
+  if (p.search_vote_iters < -1) throw Error("search-vote iterations", "must be >= 0");
+  if (p.patch_match_iters < -1) throw Error("PatchMatch iterations", "must be >= 0");
+  if (!std::isfinite(p.style_weight)) throw Error("style weight", "must be finite");
+
+  const int sw = plane_width(in.style), sh = plane_height(in.style);
+  const int ns = plane_channels(in.style);
+  if (sw <= 0 || sh <= 0) throw Error(in.style_name, "style image is empty");
+  if (ns < 1 || ns > 4)
+    throw Error(in.style_name, fmt::format("style must have 1 to 4 channels (has {})", ns));
+  check_finite(in.style, in.style_name);
+  if (in.guides.empty()) throw Error("guides", "at least one guide pair is needed");
+  int tw = -1, th = -1;
+  std::string first_target;
+  for (const auto& g : in.guides) {
+    if (plane_width(g.source) != sw || plane_height(g.source) != sh)
+      throw Error(g.name, fmt::format("source guide is {}x{} but the style is {}x{}",
+                                      plane_width(g.source), plane_height(g.source), sw, sh));
+    if (tw < 0) {
+      tw = plane_width(g.target), th = plane_height(g.target);
+      first_target = g.name;
+    } else if (plane_width(g.target) != tw || plane_height(g.target) != th) {
+      throw Error(g.name, fmt::format("target guide is {}x{} but '{}' is {}x{}",
+                                      plane_width(g.target), plane_height(g.target), first_target,
+                                      tw, th));
+    }
+    const int cs = plane_channels(g.source), ct = plane_channels(g.target);
+    if (cs != ct)
+      throw Error(g.name, fmt::format("source guide has {} channels, target guide {}", cs, ct));
+    if (cs < 1 || cs > 4)
+      throw Error(g.name, fmt::format("a guide must have 1 to 4 channels (has {})", cs));
+    if (!(g.weight < 0.0f || std::isfinite(g.weight)))
+      throw Error(g.name, "weight must be a finite number >= 0");
+    check_finite(g.source, g.name);
+    check_finite(g.target, g.name);
+  }
+  if (sw < p.patch_size || sh < p.patch_size)
+    throw Error(in.style_name, fmt::format("style image {}x{} is smaller than the {}x{} patch", sw,
+                                           sh, p.patch_size, p.patch_size));
+  if (tw < p.patch_size || th < p.patch_size)
+    throw Error(first_target, fmt::format("target {}x{} is smaller than the {}x{} patch", tw, th,
+                                          p.patch_size, p.patch_size));
+  if (in.target_mask) {
+    if (plane_width(*in.target_mask) != tw || plane_height(*in.target_mask) != th)
+      throw Error(in.target_mask_name, fmt::format("mask is {}x{} but the target is {}x{}",
+                                                   plane_width(*in.target_mask),
+                                                   plane_height(*in.target_mask), tw, th));
+    check_finite(*in.target_mask, in.target_mask_name);
+  }
+}
+
+std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
+  std::vector<LevelSchedule> s(levels);
+  if (p.search_vote_iters >= 0 || p.patch_match_iters >= 0) {
+    for (auto& l : s) {
+      l.search_vote_iters = p.search_vote_iters >= 0 ? p.search_vote_iters : 6;
+      l.patch_match_iters = p.patch_match_iters >= 0 ? p.patch_match_iters : 4;
+      l.max_search_radius = 0;
+    }
+    return s;
+  }
+  // emaki's schedule: the coarse levels (cheap) search the whole exemplar as EbSynth does; the
+  // two finest levels, which cost 15/16 of the time, start from a field that is already good
+  // and mostly refine it, so they run fewer iterations with a bounded search radius.
+  for (int l = 0; l < levels; ++l) {
+    const int from_finest = levels - 1 - l;
+    if (from_finest == 0) s[l] = {2, 2, 64};
+    else if (from_finest == 1) s[l] = {3, 3, 64};
+    else s[l] = {6, 4, 0};
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Synthesis
+
+namespace {
+
+struct Level {
+  int sw = 0, sh = 0, tw = 0, th = 0;
+  Image<int16_t> src;       // sw x sh features
+  Image<int16_t> tgt;       // padded target features
+  Image<float> src_style;   // sw x sh style values, for voting
+  Image<uint8_t> active;    // tw x th, or empty
+};
+
+FeatureLayout make_layout(const Inputs& in, const Params& p) {
+  FeatureLayout L;
+  L.style_channels = plane_channels(in.style);
+  for (const auto& g : in.guides) L.guide_channels += plane_channels(g.source);
+  const int n = L.style_channels + L.guide_channels;
+  L.channels = (n + 7) / 8 * 8;
+  std::vector<float> w;
+  std::vector<std::pair<float, float>> range;
+  auto add_range = [&](const Plane& a, const Plane* b, int c) {
+    if (!is_float(a) && (b == nullptr || !is_float(*b))) {
+      range.push_back({0.0f, 1.0f});
+      return;
+    }
+    float lo = 0.0f, hi = 1.0f;  // [0, 1] unless the values leave it
+    float mn = INFINITY, mx = -INFINITY;
+    plane_range(a, c, mn, mx);
+    if (b) plane_range(*b, c, mn, mx);
+    if (mn < 0.0f || mx > 1.0f) lo = mn, hi = std::max(mx, mn + 1e-12f);
+    range.push_back({lo, hi});
+  };
+  const float style_w = p.style_weight < 0.0f ? 1.0f : p.style_weight;
+  for (int c = 0; c < L.style_channels; ++c) {
+    w.push_back(style_w / float(L.style_channels));
+    add_range(in.style, nullptr, c);
+  }
+  for (const auto& g : in.guides) {
+    const int nc = plane_channels(g.source);
+    for (int c = 0; c < nc; ++c) {
+      w.push_back(guide_weight(g, in.guides.size()) / float(nc));
+      add_range(g.source, &g.target, c);
+    }
+  }
+  float w_max = 0.0f;
+  for (float x : w) w_max = std::max(w_max, x);
+  if (w_max <= 0.0f) w_max = 1.0f;
+  for (int c = 0; c < n; ++c) {
+    ChannelMap m;
+    m.lo = range[c].first;
+    m.mult = float(kQuantMax * std::sqrt(double(w[c]) / w_max) / (range[c].second - range[c].first));
+    L.map.push_back(m);
+  }
+  L.err_scale = 65025.0 * w_max / (double(kQuantMax) * kQuantMax);
+  return L;
+}
+
+// Writes channels [c0, c0 + channels(plane)) of features at (x + off, y + off).
+void quantize_plane(const Plane& plane, const FeatureLayout& L, int c0, Image<int16_t>& feat,
+                    int off) {
+  const int nc = plane_channels(plane), w = plane_width(plane);
+  parallel_rows(plane_height(plane), 32, [&](int y0, int y1) {
+    for_each_row(plane, y0, y1, [&](int y, const float* row) {
+      for (int x = 0; x < w; ++x) {
+        int16_t* f = feat.at(x + off, y + off);
+        for (int c = 0; c < nc; ++c) f[c0 + c] = L.map[c0 + c].quantize(row[x * nc + c]);
+      }
+    });
+  });
+}
+
+void write_style(const Image<float>& style, const FeatureLayout& L, Image<int16_t>& tgt,
+                 int border) {
+  const int ns = L.style_channels;
+  parallel_rows(style.height(), 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < style.width(); ++x) {
+        const float* s = style.at(x, y);
+        int16_t* f = tgt.at(x + border, y + border);
+        for (int c = 0; c < ns; ++c) f[c] = L.map[c].quantize(s[c]);
+      }
+  });
+  pad_replicate(tgt, border, 0, ns);
+}
+
+Image<int32_t> upscale_nnf(const Image<int32_t>& coarse, int tw, int th, int sw, int sh, int r) {
+  Image<int32_t> out(tw, th, 2);
+  parallel_rows(th, 64, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < tw; ++x) {
+        const int32_t* m = coarse.at(std::min(x / 2, coarse.width() - 1),
+                                     std::min(y / 2, coarse.height() - 1));
+        out(x, y, 0) = std::clamp(2 * m[0] + (x & 1), r, sw - r - 1);
+        out(x, y, 1) = std::clamp(2 * m[1] + (y & 1), r, sh - r - 1);
+      }
+  });
+  return out;
+}
+
+Image<int32_t> random_nnf(int tw, int th, int sw, int sh, int r, uint64_t seed) {
+  Image<int32_t> out(tw, th, 2);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      CounterRng rng(hash_key(seed, 0x1417, uint64_t(y) * 65536u + uint64_t(x)));
+      out(x, y, 0) = r + int(rng.uniform(uint32_t(sw - 2 * r)));
+      out(x, y, 1) = r + int(rng.uniform(uint32_t(sh - 2 * r)));
+    }
+  return out;
+}
+
+}  // namespace
+
+Result synthesize(const Inputs& in, const Params& params, const OutputRequest& request) {
+  validate(in, params);
+  const int p = params.patch_size, r = p / 2;
+  const int border = r;
+  const int sw = plane_width(in.style), sh = plane_height(in.style);
+  const int tw = plane_width(in.guides[0].target), th = plane_height(in.guides[0].target);
+  const FeatureLayout layout = make_layout(in, params);
+  const int ns = layout.style_channels;
+  const PatchSsdFn ssd = best_patch_ssd();
+
+  int levels = max_pyramid_levels(sw, sh, tw, th, p);
+  if (params.pyramid_levels > 0) levels = std::min(levels, params.pyramid_levels);
+  const std::vector<LevelSchedule> schedule = make_schedule(params, levels);
+
+  // Finest level (index 0) from the inputs; coarser ones by low-pass halving.
+  std::vector<Level> pyr(levels);
+  {
+    Level& f = pyr[0];
+    f.sw = sw, f.sh = sh, f.tw = tw, f.th = th;
+    f.src.reset(sw, sh, layout.channels);
+    f.tgt.reset(tw + 2 * border, th + 2 * border, layout.channels);
+    quantize_plane(in.style, layout, 0, f.src, 0);
+    int c = ns;
+    for (const auto& g : in.guides) {
+      quantize_plane(g.source, layout, c, f.src, 0);
+      quantize_plane(g.target, layout, c, f.tgt, border);
+      c += plane_channels(g.source);
+    }
+    pad_replicate(f.tgt, border, ns, layout.channels);
+    f.src_style.reset(sw, sh, ns);
+    for_each_row(in.style, 0, sh, [&](int y, const float* row) {
+      std::copy(row, row + std::size_t(sw) * ns, f.src_style.row(y));
+    });
+    if (in.target_mask) {
+      // Synthesize the mask dilated by the patch radius, so pixels at its edge get whole patches.
+      Image<uint8_t> inside(tw, th, 1);
+      for_each_row(*in.target_mask, 0, th, [&](int y, const float* row) {
+        const int mc = plane_channels(*in.target_mask);
+        for (int x = 0; x < tw; ++x) inside(x, y) = row[x * mc] > 0.0f ? 1 : 0;
+      });
+      f.active.reset(tw, th, 1);
+      for (int y = 0; y < th; ++y)
+        for (int x = 0; x < tw; ++x) {
+          uint8_t v = 0;
+          for (int dy = -r; dy <= r && !v; ++dy)
+            for (int dx = -r; dx <= r && !v; ++dx) {
+              const int xx = x + dx, yy = y + dy;
+              if (xx >= 0 && xx < tw && yy >= 0 && yy < th) v = inside(xx, yy);
+            }
+          f.active(x, y) = v;
+        }
+    }
+  }
+  for (int l = 1; l < levels; ++l) {
+    Level& c = pyr[l];
+    const Level& f = pyr[l - 1];
+    c.src = downsample(f.src.cview());
+    c.src_style = downsample(f.src_style.cview());
+    Image<int16_t> t = downsample(interior(f.tgt, border));
+    c.sw = c.src.width(), c.sh = c.src.height(), c.tw = t.width(), c.th = t.height();
+    c.tgt.reset(c.tw + 2 * border, c.th + 2 * border, layout.channels);
+    for (int y = 0; y < c.th; ++y)
+      std::copy(t.row(y), t.row(y) + std::size_t(c.tw) * layout.channels, c.tgt.at(border, y + border));
+    pad_replicate(c.tgt, border, ns, layout.channels);
+    if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
+  }
+
+  Image<int32_t> nnf;
+  Image<float> err;
+  Image<float> style;
+  auto run_level = [&](Level& L, int level_index, const LevelSchedule& sch, int patch,
+                       float uniformity) {
+    const int pr = patch / 2;
+    PatchMatchLevel pm{L.sw, L.sh, L.tw, L.th, border, &L.src, &L.tgt, &L.active, &nnf, &err};
+    if (err.width() != L.tw || err.height() != L.th) err.reset(L.tw, L.th, 1);
+    PatchMatchConfig cfg;
+    cfg.patch_size = patch;
+    cfg.uniformity = uniformity;
+    cfg.iterations = sch.patch_match_iters;
+    cfg.max_search_radius = sch.max_search_radius;
+    cfg.err_scale = layout.err_scale;
+    cfg.ssd = ssd;
+    for (int it = 0; it < sch.search_vote_iters; ++it) {
+      cfg.seed = hash_key(params.seed, uint64_t(level_index), uint64_t(it), uint64_t(patch));
+      compute_errors(pm, cfg);
+      run_patch_match(pm, cfg);
+      vote(L.src_style.cview(), nnf, err, L.active, patch, params.vote_mode, style);
+      write_style(style, layout, L.tgt, border);
+    }
+    (void)pr;
+  };
+
+  for (int l = levels - 1; l >= 0; --l) {
+    Level& L = pyr[l];
+    if (params.progress) params.progress(levels - 1 - l, levels);
+    if (l == levels - 1) nnf = random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
+    else nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
+    err.reset(L.tw, L.th, 1);
+    vote(L.src_style.cview(), nnf, err, L.active, p, VoteMode::kPlain, style);
+    write_style(style, layout, L.tgt, border);
+    run_level(L, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
+    if (l > 0) pyr[l] = Level();  // free the coarse level
+  }
+  if (params.extra_pass_3x3) {
+    LevelSchedule s = schedule.back();
+    run_level(pyr[0], levels, s, 3, 0.0f);
+  }
+
+  Result res;
+  res.pyramid_levels = levels;
+  res.schedule = schedule;
+  const Level& F = pyr[0];
+  const int out_c = ns + (in.target_mask ? 1 : 0);
+  res.image.reset(tw, th, out_c);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x)
+      for (int c = 0; c < ns; ++c) res.image(x, y, c) = style(x, y, c);
+  if (in.target_mask) {
+    for_each_row(*in.target_mask, 0, th, [&](int y, const float* row) {
+      const int mc = plane_channels(*in.target_mask);
+      for (int x = 0; x < tw; ++x) {
+        const float a = std::clamp(row[x * mc], 0.0f, 1.0f);
+        res.image(x, y, ns) = a;
+        if (a <= 0.0f)
+          for (int c = 0; c < ns; ++c) res.image(x, y, c) = 0.0f;
+      }
+    });
+  }
+  if (request.nnf) {
+    res.nnf.reset(tw, th, 2);
+    for (int y = 0; y < th; ++y)
+      for (int x = 0; x < tw; ++x) {
+        const bool act = F.active.empty() || F.active(x, y);
+        res.nnf(x, y, 0) = act ? nnf(x, y, 0) : -1;
+        res.nnf(x, y, 1) = act ? nnf(x, y, 1) : -1;
+      }
+  }
+  if (request.error) {
+    PatchMatchLevel pm{F.sw, F.sh, F.tw, F.th, border, &F.src, &F.tgt, &F.active, &nnf, &err};
+    PatchMatchConfig cfg;
+    cfg.patch_size = params.extra_pass_3x3 ? 3 : p;
+    cfg.err_scale = layout.err_scale;
+    cfg.ssd = ssd;
+    compute_errors(pm, cfg);
+    res.error = std::move(err);
+  }
+  return res;
+}
+
+}  // namespace emaki::synth

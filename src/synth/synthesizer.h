@@ -1,0 +1,104 @@
+// Guided patch-based synthesis (Image Analogies, A : A' :: B : B'): given a style exemplar A',
+// source guides A_k and target guides B_k, synthesize B' so that A : A' :: B : B'.
+// Multiscale PatchMatch with an occupancy-based uniformity term (EbSynth's), voting, and an
+// optional target mask. No file I/O: images come and go in memory.
+//
+// Units. Patch error is EbSynth's: sum over patch pixels and channels of
+// weight_c * (255 * (a_c - b_c))^2 for values in [0, 1], so `uniformity` has EbSynth's meaning.
+// Float guides whose values leave [0, 1] are normalised by their range over source and target.
+//
+// Precision. Each channel is quantised to 16383 * sqrt(weight_c / max_weight) levels over its
+// range (14 bits for the heaviest channel; at least 12 bits for every channel whose weight is
+// at least 1/16 of the heaviest; lighter channels are quantised more coarsely, in proportion to
+// how little they count). Patch sums are exact 64-bit integers, so the SIMD and scalar kernels
+// agree bit for bit and results never depend on the thread count.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/image.h"
+
+namespace emaki::synth {
+
+// A read-only input plane: 8-bit and 16-bit samples mean [0, 1]; float samples are taken as-is.
+using Plane = std::variant<ImageView<const uint8_t>, ImageView<const uint16_t>, ImageView<const float>>;
+
+int plane_width(const Plane& p);
+int plane_height(const Plane& p);
+int plane_channels(const Plane& p);
+
+struct GuidePair {
+  std::string name;     // shown in error messages (a file name, a pass name)
+  Plane source;         // A_k, the size of the style exemplar
+  Plane target;         // B_k, the size of the output
+  float weight = -1.0f; // >= 0; negative: 1 / number of guides (EbSynth's default)
+};
+
+enum class VoteMode {
+  kPlain,     // every overlapping patch counts the same
+  kWeighted,  // patches count 1 / (1 + their error per pixel and channel): sharper
+};
+
+// Iterations at one pyramid level.
+struct LevelSchedule {
+  int search_vote_iters = 6;
+  int patch_match_iters = 4;
+  // Random search starts at this radius in pixels (0: the whole exemplar) and halves down to 1.
+  int max_search_radius = 0;
+};
+
+struct Params {
+  float style_weight = -1.0f;  // >= 0, spread over the style channels; negative: 1
+  float uniformity = 3500.0f;  // >= 0; 500..15000 sensible; 0 disables the uniformity term
+  int patch_size = 5;          // odd, >= 3
+  int pyramid_levels = -1;     // >= 1; -1: as many as fit (coarsest side >= 2 * patch_size + 1)
+  // -1: emaki's schedule (full search at coarse levels, leaner at the fine ones);
+  // >= 0: that many at every level (EbSynth's behaviour; its defaults are 6 and 4).
+  int search_vote_iters = -1;
+  int patch_match_iters = -1;
+  bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
+  VoteMode vote_mode = VoteMode::kWeighted;
+  uint64_t seed = 1;
+  // Optional progress callback: (level, levels).
+  std::function<void(int, int)> progress;
+};
+
+struct Inputs {
+  Plane style;                    // A', 1 to 4 channels
+  std::string style_name = "style";
+  std::vector<GuidePair> guides;  // at least one
+  // Optional target mask (first channel, > 0.5 is inside). Pixels outside are not synthesized
+  // and come out transparent: B' then gets one more channel, alpha.
+  std::optional<Plane> target_mask;
+  std::string target_mask_name = "mask";
+};
+
+struct OutputRequest {
+  bool nnf = false;    // nearest-neighbour field: 2 channels (x, y) of the source patch centre
+  bool error = false;  // per-pixel patch error (EbSynth units)
+};
+
+struct Result {
+  Image<float> image;    // B': style channels, plus alpha when a mask was given
+  Image<int32_t> nnf;    // when requested; (-1, -1) outside the mask
+  Image<float> error;    // when requested; 0 outside the mask
+  int pyramid_levels = 0;
+  std::vector<LevelSchedule> schedule;
+};
+
+// Checks the inputs (sizes, channel counts, finite values, parameter ranges) and throws
+// emaki::Error naming the offending guide or parameter.
+void validate(const Inputs& inputs, const Params& params);
+
+// The schedule the synthesizer will run for these sizes and parameters.
+std::vector<LevelSchedule> make_schedule(const Params& params, int levels);
+int max_pyramid_levels(int sw, int sh, int tw, int th, int patch_size);
+
+Result synthesize(const Inputs& inputs, const Params& params, const OutputRequest& request = {});
+
+}  // namespace emaki::synth

@@ -1,0 +1,47 @@
+#include "synth/voting.h"
+
+#include <vector>
+
+#include "core/parallel.h"
+
+namespace emaki::synth {
+
+void vote(ImageView<const float> source, const Image<int32_t>& nnf, const Image<float>& err,
+          const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out) {
+  const int tw = nnf.width(), th = nnf.height(), nc = source.channels;
+  const int r = patch_size / 2;
+  if (out.width() != tw || out.height() != th || out.channels() != nc) out.reset(tw, th, nc);
+  const bool all = active.empty();
+  // EbSynth's weighting: error per patch pixel and channel.
+  const float err_norm = 1.0f / float(patch_size * patch_size * nc);
+  parallel_rows(th, 16, [&](int y0, int y1) {
+    std::vector<float> acc(nc);
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < tw; ++x) {
+        float* o = out.at(x, y);
+        if (!all && !active(x, y)) {
+          for (int c = 0; c < nc; ++c) o[c] = 0.0f;
+          continue;
+        }
+        std::fill(acc.begin(), acc.end(), 0.0f);
+        float wsum = 0.0f;
+        for (int oy = -r; oy <= r; ++oy) {
+          const int uy = y + oy;
+          if (uy < 0 || uy >= th) continue;
+          for (int ox = -r; ox <= r; ++ox) {
+            const int ux = x + ox;
+            if (ux < 0 || ux >= tw || (!all && !active(ux, uy))) continue;
+            const int32_t* m = nnf.at(ux, uy);
+            const float* s = source.at(m[0] - ox, m[1] - oy);
+            const float w = mode == VoteMode::kPlain ? 1.0f : 1.0f / (1.0f + err(ux, uy) * err_norm);
+            for (int c = 0; c < nc; ++c) acc[c] += w * s[c];
+            wsum += w;
+          }
+        }
+        const float inv = 1.0f / wsum;  // the pixel's own patch always counts: wsum > 0
+        for (int c = 0; c < nc; ++c) o[c] = acc[c] * inv;
+      }
+  });
+}
+
+}  // namespace emaki::synth

@@ -1,0 +1,15 @@
+// Voting: each target pixel becomes the (weighted) average of the source pixels that the
+// overlapping target patches map onto it.
+#pragma once
+
+#include "core/image.h"
+#include "synth/synthesizer.h"
+
+namespace emaki::synth {
+
+// nnf: tw x th x 2 source patch centres; err: patch errors (used by kWeighted); active: tw x th
+// or empty. Writes `out` (tw x th x source channels); inactive pixels get 0.
+void vote(ImageView<const float> source, const Image<int32_t>& nnf, const Image<float>& err,
+          const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out);
+
+}  // namespace emaki::synth
