@@ -10,6 +10,8 @@ namespace emaki::app {
 using Args = std::vector<std::string>;
 
 int run_synth(const Args& args);
+int run_render(const Args& args);
+int run_template(const Args& args);
 
 struct Command {
   const char* name;

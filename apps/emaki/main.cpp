@@ -11,6 +11,9 @@ namespace emaki::app {
 const std::vector<Command>& commands() {
   static const std::vector<Command> list = {
       {"synth", "guided patch-based synthesis (EbSynth-compatible command line)", run_synth},
+      {"render", "guide passes of a glTF scene, one multilayer EXR per frame", run_render},
+      {"template", "reference sphere passes and a paint template (or fit them to a painting)",
+       run_template},
   };
   return list;
 }

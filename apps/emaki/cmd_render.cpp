@@ -1,0 +1,133 @@
+// `emaki render`: a glTF scene's guide passes, one multilayer EXR per frame.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "apps/emaki/commands.h"
+#include "apps/emaki/shot_options.h"
+#include "core/error.h"
+#include "io/gltf_loader.h"
+#include "io/image_io.h"
+#include "render/passes.h"
+#include "render/renderer.h"
+
+namespace emaki::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+void parse_frames(const std::string& text, int& first, int& last) {
+  try {
+    std::size_t pos = 0;
+    const std::size_t dash = text.find('-', 1);
+    first = std::stoi(text.substr(0, dash), &pos);
+    if (pos != std::min(dash, text.size())) throw std::invalid_argument(text);
+    last = first;
+    if (dash != std::string::npos) {
+      last = std::stoi(text.substr(dash + 1), &pos);
+      if (pos != text.size() - dash - 1) throw std::invalid_argument(text);
+    }
+  } catch (const std::exception&) {
+    throw Error("--frames", fmt::format("expects A-B or A (frame numbers >= 0), got '{}'", text));
+  }
+  if (first < 0 || last < first)
+    throw Error("--frames", fmt::format("expects 0 <= A <= B, got '{}'", text));
+}
+
+void make_dir(const std::string& option, const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw Error(option, fmt::format("cannot create folder '{}'", dir.string()));
+}
+
+}  // namespace
+
+// Writes one frame's EXR (atomically) and, if asked, a PNG per pass.
+void write_frame(const Image<float>& frame, const fs::path& exr, const fs::path& preview_dir,
+                 const std::string& stem, bool half) {
+  io::WriteOptions wo;
+  wo.format = half ? io::SampleFormat::kHalf : io::SampleFormat::kFloat;
+  wo.channel_names = render::channel_names();
+  io::write_image(exr.string(), frame.cview(), wo);
+  if (preview_dir.empty()) return;
+  for (const render::PassInfo& pass : render::pass_table()) {
+    const Image<float> p = render::preview(frame.cview(), pass);
+    io::WriteOptions po;
+    po.format = io::SampleFormat::kU8;
+    io::write_image((preview_dir / fmt::format("{}_{}.png", stem, pass.name)).string(), p.cview(), po);
+  }
+}
+
+int run_render(const Args& args) {
+  CLI::App app{
+      "Renders the guide passes of a glTF 2.0 scene (.gltf/.glb): one multilayer EXR per frame, "
+      "DIR/frame_NNNN.exr, channels as in docs/passes.md.",
+      "emaki render"};
+  std::string scene_path, frames = "0", out_dir, clip;
+  float fps = 24.0f;
+  bool previews = false, full_float = false, quiet = false;
+  ShotOptions so;
+  app.add_option("scene", scene_path, "the scene, .gltf or .glb")->required();
+  app.add_option("--frames", frames,
+                 "frame range A-B (or one frame A), A >= 0; frame f is at clip start + f / fps")
+      ->capture_default_str();
+  app.add_option("--out", out_dir, "output folder (created if missing)")->required();
+  app.add_option("--clip", clip, "animation clip by name; default: the first clip");
+  app.add_option("--fps", fps, "frames per second, > 0")->check(CLI::PositiveNumber)->capture_default_str();
+  so.add_to(app, true);
+  app.add_flag("--previews", previews, "also write DIR/preview/frame_NNNN_<pass>.png for every pass");
+  app.add_flag("--float", full_float, "32-bit float EXR channels (default: half)");
+  app.add_flag("--quiet", quiet, "no progress on stderr");
+  if (parse_cli(app, args)) return 0;
+
+  scene::ShotSpec shot;
+  render::RenderOptions options;
+  so.resolve(shot, options);
+  parse_frames(frames, shot.first_frame, shot.last_frame);
+  shot.fps = fps;
+  shot.clip = clip;
+
+  const scene::Scene scene = io::load_gltf(scene_path);
+  const render::ShotRenderer renderer(scene, shot, options);
+  const fs::path dir(out_dir);
+  make_dir("--out", dir);
+  io::check_writable((dir / "frame_0000.exr").string());
+  fs::path preview_dir;
+  if (previews) {
+    preview_dir = dir / "preview";
+    make_dir("--out", preview_dir);
+  }
+
+  const int count = shot.last_frame - shot.first_frame + 1;
+  const bool tty = isatty(fileno(stderr));
+  const auto start = std::chrono::steady_clock::now();
+  for (int f = shot.first_frame; f <= shot.last_frame; ++f) {
+    const Image<float> frame = renderer.render(f);
+    if (render::object_coverage(frame.cview()) == 0.0f)
+      throw Error(scene_path, fmt::format("frame {}: the camera sees nothing of the scene (all "
+                                          "background); check --camera, --target and --fov", f));
+    const std::string stem = fmt::format("frame_{:04d}", f);
+    write_frame(frame, dir / (stem + ".exr"), preview_dir, stem, !full_float);
+    if (!quiet) {
+      const int done = f - shot.first_frame + 1;
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double per = elapsed / done;
+      std::fprintf(stderr, "%semaki render: frame %d (%d/%d)  %.2f s/frame  ETA %.0f s%s",
+                   tty ? "\r" : "", f, done, count, per, per * (count - done),
+                   tty && done < count ? "   " : "\n");
+      std::fflush(stderr);
+    }
+  }
+  if (!quiet)
+    std::fprintf(stderr, "emaki render: wrote %d frame(s) to %s\n", count, dir.string().c_str());
+  return 0;
+}
+
+}  // namespace emaki::app

@@ -1,0 +1,179 @@
+#include "apps/emaki/shot_options.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "core/parallel.h"
+
+namespace emaki::app {
+
+std::vector<float> parse_floats(const std::string& option, const std::string& text, int count) {
+  std::vector<float> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    try {
+      std::size_t pos = 0;
+      const float v = std::stof(item, &pos);
+      if (pos != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+      out.push_back(v);
+    } catch (const std::exception&) {
+      throw Error(option, fmt::format("expects {} comma-separated numbers, got '{}'", count, text));
+    }
+    start = end + 1;
+  }
+  if (int(out.size()) != count)
+    throw Error(option, fmt::format("expects {} comma-separated numbers, got '{}'", count, text));
+  return out;
+}
+
+void parse_size(const std::string& option, const std::string& text, int& width, int& height) {
+  const std::size_t x = text.find('x');
+  try {
+    if (x == std::string::npos) throw std::invalid_argument(text);
+    std::size_t p1 = 0, p2 = 0;
+    width = std::stoi(text.substr(0, x), &p1);
+    height = std::stoi(text.substr(x + 1), &p2);
+    if (p1 != x || p2 != text.size() - x - 1) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    throw Error(option, fmt::format("expects WIDTHxHEIGHT, e.g. 1280x720, got '{}'", text));
+  }
+  if (width < 1 || height < 1 || width > 16384 || height > 16384)
+    throw Error(option, fmt::format("width and height must be in [1, 16384], got '{}'", text));
+}
+
+bool parse_cli(CLI::App& app, const Args& args) {
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them reversed
+  try {
+    app.parse(reversed);
+  } catch (const CLI::CallForHelp&) {
+    std::fputs(app.help().c_str(), stdout);
+    return true;
+  } catch (const CLI::ParseError& e) {
+    std::string message = e.what();
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    throw Error("", message + " (see --help)");
+  }
+  return false;
+}
+
+void ShotOptions::add_to(CLI::App& app, bool with_motion) {
+  app.add_option("--size", size, "output size WIDTHxHEIGHT, each in [1, 16384]")
+      ->capture_default_str();
+  app.add_option("--aa", aa, "supersampling: N x N samples per pixel, [1, 4]")
+      ->check(CLI::Range(1, 4))
+      ->capture_default_str();
+  app.add_option("--outline-width", outline_width, "outline width in pixels, [0, 16]; 0 = none")
+      ->check(CLI::Range(0.0f, 16.0f))
+      ->capture_default_str();
+  app.add_option("--crease", crease_deg,
+                 "angle between face normals drawn as a crease line, degrees, [0, 180]")
+      ->check(CLI::Range(0.0f, 180.0f))
+      ->capture_default_str();
+  app.add_option("--camera", camera,
+                 "camera position X,Y,Z (world); default: placed by --azimuth/--elevation/"
+                 "--distance around the subject");
+  app.add_option("--target", target, "point the camera looks at X,Y,Z; default: the subject's centre");
+  app.add_option("--azimuth", azimuth, "automatic camera: degrees around +Y, 0 = from +Z, any value")
+      ->capture_default_str();
+  app.add_option("--elevation", elevation, "automatic camera: degrees above the horizon, [-89, 89]")
+      ->check(CLI::Range(-89.0f, 89.0f))
+      ->capture_default_str();
+  app.add_option("--distance", distance,
+                 "automatic camera: distance to the target, >= 0; 0 = fit the subject")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--fov", fov, "vertical field of view, degrees, [1, 170]")
+      ->check(CLI::Range(1.0f, 170.0f))
+      ->capture_default_str();
+  app.add_option("--ortho", ortho,
+                 "orthographic camera showing this many scene units vertically, >= 0; 0 = perspective")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  if (with_motion) {
+    app.add_option("--orbit", orbit,
+                   "camera turns this many degrees around the target over the frame range")
+        ->capture_default_str();
+    app.add_option("--dolly", dolly,
+                   "camera distance to the target is multiplied by this at the last frame, > 0")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--pan", pan, "camera and target move by X,Y,Z over the frame range");
+    app.add_option("--gltf-camera", gltf_camera,
+                   "use the glTF camera on this node index (animated with the clip)");
+  }
+  app.add_option("--light", light,
+                 "direction towards the key light X,Y,Z, relative to the camera (x right, y up, "
+                 "z towards the viewer) unless --light-world")
+      ->capture_default_str();
+  app.add_flag("--light-world", light_world, "--light is a world-space direction (+Y up)");
+  app.add_option("--softness", softness,
+                 "angular size of the key light in degrees (shadow penumbra), [0, 45]")
+      ->check(CLI::Range(0.0f, 45.0f))
+      ->capture_default_str();
+  app.add_flag("--no-ground", no_ground, "no ground plane");
+  app.add_option("--ground-size", ground_size,
+                 "side of the square ground plane, scene units, >= 0; 0 = 6x the subject")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--ground-height", ground_height,
+                 "y of the ground plane; default: under the lowest point of the subject");
+  app.add_option("--ground-color", ground_color, "linear RGB albedo of the ground, each in [0, 1]")
+      ->capture_default_str();
+  app.add_option("--background", background, "linear RGB background colour (albedo pass)")
+      ->capture_default_str();
+  app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
+void ShotOptions::resolve(scene::ShotSpec& shot, render::RenderOptions& options) const {
+  parse_size("--size", size, options.width, options.height);
+  options.aa = aa;
+  options.outline_width = outline_width;
+  options.crease_deg = crease_deg;
+  auto vec3 = [](const std::string& opt, const std::string& text) {
+    const std::vector<float> v = parse_floats(opt, text, 3);
+    return glm::vec3(v[0], v[1], v[2]);
+  };
+  scene::CameraSpec& cam = shot.camera;
+  cam.azimuth_deg = azimuth;
+  cam.elevation_deg = elevation;
+  cam.distance = distance;
+  cam.fov_deg = fov;
+  cam.orthographic = ortho > 0.0f;
+  cam.ortho_height = ortho;
+  if (!target.empty()) cam.target = vec3("--target", target), cam.has_target = true;
+  if (!camera.empty()) {
+    cam.mode = scene::CameraSpec::Mode::kLookAt;
+    cam.position = vec3("--camera", camera);
+    if (!cam.has_target) throw Error("--camera", "needs --target as well");
+  }
+  cam.orbit_deg = orbit;
+  cam.dolly = dolly;
+  if (!pan.empty()) cam.pan = vec3("--pan", pan);
+  if (gltf_camera >= 0) {
+    cam.mode = scene::CameraSpec::Mode::kGltf;
+    cam.gltf_node = gltf_camera;
+  }
+  shot.light.direction = vec3("--light", light);
+  if (glm::length(shot.light.direction) == 0.0f) throw Error("--light", "must not be 0,0,0");
+  shot.light.camera_relative = !light_world;
+  shot.light.softness_deg = softness;
+  shot.ground.enabled = !no_ground;
+  shot.ground.size = ground_size;
+  if (!ground_height.empty()) {
+    shot.ground.height = parse_floats("--ground-height", ground_height, 1)[0];
+    shot.ground.auto_height = false;
+  }
+  shot.ground.color = vec3("--ground-color", ground_color);
+  shot.background = vec3("--background", background);
+  set_thread_count(threads);
+}
+
+}  // namespace emaki::app

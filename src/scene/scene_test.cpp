@@ -1,0 +1,2 @@
+#include <gtest/gtest.h>
+TEST(Scene, Placeholder) { EXPECT_TRUE(true); }

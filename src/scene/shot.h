@@ -1,0 +1,86 @@
+// What a shot adds to a scene file: camera (fixed, or orbit / dolly / pan over the frame range),
+// a directional key light, an optional ground plane, a background colour, the clip and frame
+// range. Filled by the CLI now and by the shot file later; resolved per frame into a ViewCamera.
+#pragma once
+
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace emaki::scene {
+
+struct CameraSpec {
+  enum class Mode {
+    kAuto,    // look at the shot's bounds from (azimuth, elevation), distance fitted to them
+    kLookAt,  // from `position` towards `target`
+    kGltf,    // the glTF camera on node `gltf_node`, animated with the clip
+  };
+  Mode mode = Mode::kAuto;
+  glm::vec3 position{0.0f, 0.0f, 5.0f};
+  glm::vec3 target{0.0f};
+  bool has_target = false;   // kAuto: aim at `target` instead of the bounds' centre
+  float azimuth_deg = 30.0f;   // kAuto: around +Y, 0 = looking from +Z (glTF front)
+  float elevation_deg = 15.0f; // kAuto: above the horizon
+  float distance = 0.0f;     // kAuto: 0 = fit the bounds
+  float fov_deg = 40.0f;     // vertical field of view, (0, 170)
+  bool orthographic = false;
+  float ortho_height = 0.0f;  // full visible height in scene units; 0 = fit (kAuto)
+  int gltf_node = -1;
+  // Motion from the first to the last frame of the range (linear, extrapolated outside it).
+  float orbit_deg = 0.0f;  // turn around the target about +Y
+  float dolly = 1.0f;      // distance to the target is multiplied by this at the last frame
+  glm::vec3 pan{0.0f};     // camera and target move by this
+  // Principal point offset in NDC units (x right, y up; 1 = half the image): lens shift, used to
+  // put an on-axis sphere at an off-centre spot of a painting.
+  glm::vec2 shift{0.0f};
+};
+
+struct LightSpec {
+  // Direction towards the light. Camera-relative directions (x right, y up, z towards the
+  // viewer) are turned into world space with the camera of the first frame and then held fixed.
+  glm::vec3 direction{-1.0f, 1.0f, 1.0f};
+  bool camera_relative = true;
+  float softness_deg = 2.0f;  // angular size of the light: widens the shadow penumbra, [0, 45]
+};
+
+struct GroundSpec {
+  bool enabled = true;
+  float size = 0.0f;    // side of the square; 0 = 6x the shot's bounds
+  float height = 0.0f;  // y of the plane
+  bool auto_height = true;  // put it under the lowest point of the shot
+  glm::vec3 color{0.8f};  // linear albedo
+};
+
+struct ShotSpec {
+  CameraSpec camera;
+  LightSpec light;
+  GroundSpec ground;
+  glm::vec3 background{0.0f};
+  std::string clip;  // animation name; empty = the first clip, if any
+  float fps = 24.0f;
+  int first_frame = 0;  // frame f is at time clip.start + f / fps
+  int last_frame = 0;
+};
+
+// A resolved camera: world -> camera (looking down -Z, +Y up) and projection parameters.
+struct ViewCamera {
+  glm::mat4 view{1.0f};
+  bool perspective = true;
+  float tan_half_fov = 0.364f;  // tan(vertical fov / 2)
+  float ortho_half_height = 1.0f;
+  glm::vec2 shift{0.0f};
+  float znear = 0.01f;
+  glm::vec3 position() const;
+};
+
+// The camera at `frame` (fractional frames allowed). `bounds` are the shot's world bounds
+// (union over the frame range); `pose` is the scene's pose at that frame (for glTF cameras).
+ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
+                     const Bounds& bounds, float frame, float aspect);
+
+// The key light direction (unit, towards the light) in world space for the whole shot.
+glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera);
+
+}  // namespace emaki::scene
