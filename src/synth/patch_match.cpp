@@ -74,14 +74,35 @@ struct Band {
   std::vector<int32_t> changes;  // (centre index, sign) pairs to undo the delta afterwards
 };
 
-inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int cy) {
+inline float occupancy(const Sweep& S, const Band& band, int cx, int cy) {
+  const std::ptrdiff_t i = std::ptrdiff_t(cy) * S.L.sw + cx;
+  return S.occ_scale * float(S.occ[i] + band.delta[i]);
+}
+
+// Brings a candidate's source patch and occupancy into cache ahead of its evaluation: the
+// patches of random candidates are scattered over the exemplar, and fetching them all at once
+// overlaps their memory latencies.
+inline void prefetch_candidate(const Sweep& S, const Band& band, int cx, int cy) {
+  const std::ptrdiff_t i = std::ptrdiff_t(cy) * S.L.sw + cx;
+  __builtin_prefetch(S.occ + i);
+  __builtin_prefetch(band.delta + i);
+  const int16_t* s = S.L.src->at(cx - S.r, cy - S.r);
+  const int row_bytes = S.row_elems * int(sizeof(int16_t));
+  for (int j = 0; j <= 2 * S.r; ++j) {
+    const char* row = reinterpret_cast<const char*>(s + j * S.src_stride);
+    for (int b = 0; b < row_bytes; b += 64) __builtin_prefetch(row + b);
+    __builtin_prefetch(row + row_bytes - 1);
+  }
+}
+
+// Tries source centre (cx, cy) for target pixel (x, y); cur_occ is the occupancy cost of the
+// pixel's current match and is updated when the candidate is taken.
+inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int cy,
+                          float& cur_occ) {
   const PatchMatchLevel& L = S.L;
   int32_t* n = L.nnf->at(x, y);
   if (cx == n[0] && cy == n[1]) return;
-  const std::ptrdiff_t ci = std::ptrdiff_t(n[1]) * L.sw + n[0];
-  const std::ptrdiff_t ni = std::ptrdiff_t(cy) * L.sw + cx;
-  const float cur_occ = S.occ_scale * float(S.occ[ci] + band.delta[ci]);
-  const float new_occ = S.occ_scale * float(S.occ[ni] + band.delta[ni]);
+  const float new_occ = occupancy(S, band, cx, cy);
   float& e = (*L.err)(x, y);
   const float cur_cost = e + cur_occ;
   const float bound = cur_cost - new_occ;
@@ -99,6 +120,7 @@ inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int 
     add_triangle(band.delta, L.sw, L.sh, n[0], n[1], p, -1);
     add_triangle(band.delta, L.sw, L.sh, cx, cy, p, +1);
     band.changes.insert(band.changes.end(), {n[0], n[1], -1, cx, cy, +1});
+    cur_occ = occupancy(S, band, cx, cy);
   }
   n[0] = cx;
   n[1] = cy;
@@ -112,17 +134,22 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
   const int r = S.r;
   const int lo_x = r, hi_x = L.sw - r - 1, lo_y = r, hi_y = L.sh - r - 1;
   const int max_rad = S.C.max_search_radius > 0 ? S.C.max_search_radius : std::max(L.sw, L.sh);
+  int radii[32];
+  int num_radii = 0;
+  for (int rad = max_rad; rad >= 1 && num_radii < 32; rad /= 2) radii[num_radii++] = rad;
   const int ys = forward ? y0 : y1 - 1, ye = forward ? y1 : y0 - 1;
   const int xs = forward ? 0 : L.tw - 1, xe = forward ? L.tw : -1;
   for (int y = ys; y != ye; y += q) {
     for (int x = xs; x != xe; x += q) {
       if (!is_active(L, x, y)) continue;
-      // Propagation from the neighbour already visited in this sweep's direction.
+      int32_t* n = L.nnf->at(x, y);
+      float cur_occ = occupancy(S, band, n[0], n[1]);
+      // Propagation from the neighbours already visited in this sweep's direction.
       const int nx = x - q;
       if (nx >= 0 && nx < L.tw && is_active(L, nx, y)) {
         const int32_t* m = L.nnf->at(nx, y);
         const int cx = m[0] + q;
-        if (cx >= lo_x && cx <= hi_x) try_candidate(S, band, x, y, cx, m[1]);
+        if (cx >= lo_x && cx <= hi_x) try_candidate(S, band, x, y, cx, m[1], cur_occ);
       }
       const int ny = y - q;
       if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
@@ -130,18 +157,22 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
         const bool inside = ny >= y0 && ny < y1;
         const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, ny);
         const int cy = m[1] + q;
-        if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy);
+        if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy, cur_occ);
       }
-      // Random search in windows halving around the current best.
+      // Random search in windows halving around the match found so far (drawn all at once so
+      // their patches can be fetched together).
       CounterRng rng(hash_key(S.C.seed, uint64_t(iter), uint64_t(y) * 65536u + uint64_t(x)));
-      for (int rad = max_rad; rad >= 1; rad /= 2) {
-        const int32_t* m = L.nnf->at(x, y);
-        const int wx0 = std::max(lo_x, m[0] - rad), wx1 = std::min(hi_x, m[0] + rad);
-        const int wy0 = std::max(lo_y, m[1] - rad), wy1 = std::min(hi_y, m[1] + rad);
-        const int cx = wx0 + int(rng.uniform(uint32_t(wx1 - wx0 + 1)));
-        const int cy = wy0 + int(rng.uniform(uint32_t(wy1 - wy0 + 1)));
-        try_candidate(S, band, x, y, cx, cy);
+      int cand[32][2];
+      const int px = n[0], py = n[1];
+      for (int k = 0; k < num_radii; ++k) {
+        const int rad = radii[k];
+        const int wx0 = std::max(lo_x, px - rad), wx1 = std::min(hi_x, px + rad);
+        const int wy0 = std::max(lo_y, py - rad), wy1 = std::min(hi_y, py + rad);
+        cand[k][0] = wx0 + int(rng.uniform(uint32_t(wx1 - wx0 + 1)));
+        cand[k][1] = wy0 + int(rng.uniform(uint32_t(wy1 - wy0 + 1)));
+        prefetch_candidate(S, band, cand[k][0], cand[k][1]);
       }
+      for (int k = 0; k < num_radii; ++k) try_candidate(S, band, x, y, cand[k][0], cand[k][1], cur_occ);
     }
   }
 }
@@ -187,7 +218,7 @@ std::vector<int32_t> occupancy_window_sums(const PatchMatchLevel& L, int p) {
 void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   const int r = C.patch_size / 2;
   const int row_elems = C.patch_size * L.src->channels();
-  parallel_rows(L.th, kBandRows, [&](int y0, int y1) {
+  parallel_rows(L.th, 16, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < L.tw; ++x) {
         if (!is_active(L, x, y)) {
@@ -222,7 +253,7 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
                                                       : std::vector<int32_t>(std::size_t(L.sw) * L.sh, 0);
     const Sweep sweep{L, C, occ.data(), snap, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
                       p * L.src->channels()};
-    parallel_rows(L.th, kBandRows, [&](int y0, int y1) {
+    parallel_rows(L.th, band_rows(L.th), [&](int y0, int y1) {
       Band band;
       auto buf = pool.take();
       band.delta = buf.data();

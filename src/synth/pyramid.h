@@ -10,6 +10,7 @@
 // a low-pass, which lets thin lines alias away at coarse levels).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,15 @@ inline int half_size(int n) { return (n + 1) / 2; }
 // Low-pass and halve (any channel count). Integer types round to nearest.
 Image<float> downsample(ImageView<const float> in);
 Image<int16_t> downsample(ImageView<const int16_t> in);
+// Halves by taking every other pixel, for channels [c0, c1) of `out` (already low-passed
+// everywhere else). Used for the style exemplar: a low-passed exemplar has less texture
+// contrast, so coarse levels would prefer its flattest regions and wash the result out.
+template <typename T>
+void decimate_channels(ImageView<const T> in, Image<T>& out, int c0, int c1) {
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x)
+      for (int c = c0; c < c1; ++c) out(x, y, c) = in(std::min(2 * x, in.width - 1), std::min(2 * y, in.height - 1), c);
+}
 // A mask halves to "any child inside".
 Image<uint8_t> downsample_mask(ImageView<const uint8_t> in);
 

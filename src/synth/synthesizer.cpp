@@ -342,7 +342,9 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
     Level& c = pyr[l];
     const Level& f = pyr[l - 1];
     c.src = downsample(f.src.cview());
+    decimate_channels(f.src.cview(), c.src, 0, ns);
     c.src_style = downsample(f.src_style.cview());
+    decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
     Image<int16_t> t = downsample(interior(f.tgt, border));
     c.sw = c.src.width(), c.sh = c.src.height(), c.tw = t.width(), c.th = t.height();
     c.tgt.reset(c.tw + 2 * border, c.th + 2 * border, layout.channels);
