@@ -206,27 +206,36 @@ class ShadowMap {
     rasterize(verts, idx, ro, map_);
   }
 
-  // 1 = fully lit by the key light, 0 = fully in its cast shadow.
+  // 1 = fully lit by the key light, 0 = fully in its cast shadow. The depth bias grows with the
+  // filter footprint times the surface's slope to the light, so a surface never shadows itself
+  // (near the terminator a wide filter reaches points of the same surface nearer the light).
   float visibility(const glm::vec3& p, const glm::vec3& geometric_normal) const {
     if (size_ == 0) return 1.0f;
     const glm::vec3 q = p + geometric_normal * (1.5f * texel_);
     const ClipVertex c = proj_.clip(q);
     const float u = (c.x + 1.0f) * 0.5f * size_, v = (1.0f - c.y) * 0.5f * size_;
-    const float d = c.depth - 1.5f * texel_;
-    if (tan_half_ <= 0.0f) return occluder(u, v) < d ? 0.0f : 1.0f;
+    const glm::vec3 l = glm::vec3(glm::transpose(proj_.cam.view)[2]);  // towards the light
+    const float cos_l = std::clamp(std::abs(glm::dot(geometric_normal, l)), 0.05f, 1.0f);
+    const float slope = std::min(std::sqrt(1.0f - cos_l * cos_l) / cos_l, 20.0f);
+    auto biased = [&](float radius_texels) {
+      return c.depth - texel_ * (1.5f + slope * (radius_texels + 1.0f));
+    };
+    if (tan_half_ <= 0.0f) return occluder(u, v) < biased(0.5f) ? 0.0f : 1.0f;
     // Blocker search over the largest penumbra the light could cast (occluder a whole caster
     // radius away), then a filter as wide as the penumbra at this receiver.
     const float search = std::clamp(tan_half_ * radius_ / texel_, 1.0f, 32.0f);
+    const float d_search = biased(search);
     float blockers = 0.0f;
     int n = 0;
     for (int j = -2; j <= 2; ++j)
       for (int i = -2; i <= 2; ++i) {
         const float o = occluder(u + 0.5f * i * search, v + 0.5f * j * search);
-        if (o < d) blockers += o, ++n;
+        if (o < d_search) blockers += o, ++n;
       }
     if (n == 0) return 1.0f;
     const float blocker = blockers / n;
-    const float filter = std::clamp((d - blocker) * tan_half_ / texel_, 0.5f, 32.0f);
+    const float filter = std::clamp((c.depth - blocker) * tan_half_ / texel_, 0.5f, 32.0f);
+    const float d = biased(filter);
     int lit = 0;
     for (int j = -3; j <= 3; ++j)
       for (int i = -3; i <= 3; ++i)
