@@ -93,7 +93,7 @@ scene::ShotSpec reference_shot(const ReferenceSpec& spec) {
   shot.ground.enabled = spec.ground;
   shot.ground.auto_height = false;
   shot.ground.height = 0.0f;
-  shot.ground.size = 200.0f;  // reaches close to the horizon
+  shot.ground.size = 1e4f;  // its far edge within a pixel of the true horizon
   shot.ground.color = spec.ground_color;
   shot.background = spec.background;
   shot.first_frame = shot.last_frame = 0;
