@@ -286,7 +286,12 @@ int run_synth(const Args& args) {
   synth::OutputRequest req;
   req.nnf = !nnf_out.empty();
   req.error = !error_out.empty();
-  synth::Result res = synth::synthesize(in, params, req);
+  synth::Synthesizer synthesizer(in, params);
+  // The guides are packed into the engine's features now; free them before the long part.
+  in.guides.clear();
+  loaded.clear();
+  loaded.shrink_to_fit();
+  synth::Result res = synthesizer.run(req);
   const auto t1 = std::chrono::steady_clock::now();
 
   io::WriteOptions wo;
@@ -298,8 +303,8 @@ int run_synth(const Args& args) {
   else wo.format = io::SampleFormat::kFloat;
   // A one-channel style whose file was RGB is written back as RGB, as EbSynth does.
   Image<float> out_img;
-  const int ns = in.style.index() == 0 ? synth::plane_channels(in.style) : synth::plane_channels(in.style);
-  if (ns == 1 && style_path.size() && res.image.channels() <= 2) {
+  const int ns = synth::plane_channels(in.style);
+  if (ns == 1 && res.image.channels() <= 2) {
     const bool alpha = res.image.channels() == 2;
     out_img.reset(res.image.width(), res.image.height(), alpha ? 4 : 3);
     for (int y = 0; y < res.image.height(); ++y)
@@ -330,7 +335,7 @@ int run_synth(const Args& args) {
   if (!quiet)
     std::fprintf(stderr, "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
                  out_img.width(), out_img.height(), style.width(), style.height(), ns,
-                 in.guides.size(), res.pyramid_levels,
+                 guides.size(), res.pyramid_levels,
                  std::chrono::duration<double>(t1 - t0).count());
   return 0;
 }

@@ -62,7 +62,8 @@ struct Sweep {
   const PatchMatchLevel& L;
   const PatchMatchConfig& C;
   const int32_t* occ;        // snapshot window sums, sw x sh
-  const Image<int32_t>& snap;  // field at the start of the sweep
+  const Image<int32_t>& snap;  // rows next to band edges as they were when the sweep began
+  const std::vector<int>& snap_slot;  // target row -> row of snap (-1: not kept)
   float occ_scale;           // uniformity / (p^2 * omega_best)
   int r;
   std::ptrdiff_t src_stride, tgt_stride;
@@ -155,7 +156,7 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
       if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
         // Across the band edge, read the field as it was when the sweep began.
         const bool inside = ny >= y0 && ny < y1;
-        const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, ny);
+        const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, S.snap_slot[ny]);
         const int cy = m[1] + q;
         if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy, cur_occ);
       }
@@ -246,14 +247,24 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   const float occ_scale = C.uniformity > 0.0f ? float(C.uniformity / (double(p) * p * omega_best)) : 0.0f;
 
   DeltaPool pool(std::size_t(L.sw) * L.sh);
-  Image<int32_t> snap(L.tw, L.th, 2);
+  // Only the rows on either side of a band edge are read across bands: keep just those.
+  const int band = band_rows(L.th);
+  std::vector<int> snap_slot(L.th, -1), snap_rows;
+  for (int e = band; e < L.th; e += band) {
+    snap_slot[e - 1] = int(snap_rows.size());
+    snap_rows.push_back(e - 1);
+    snap_slot[e] = int(snap_rows.size());
+    snap_rows.push_back(e);
+  }
+  Image<int32_t> snap(L.tw, std::max<int>(1, int(snap_rows.size())), 2);
   for (int iter = 0; iter < C.iterations; ++iter) {
-    std::memcpy(snap.row(0), L.nnf->row(0), L.nnf->bytes());
+    for (std::size_t k = 0; k < snap_rows.size(); ++k)
+      std::memcpy(snap.row(int(k)), L.nnf->row(snap_rows[k]), std::size_t(L.tw) * 2 * sizeof(int32_t));
     const std::vector<int32_t> occ = occ_scale > 0.0f ? occupancy_window_sums(L, p)
                                                       : std::vector<int32_t>(std::size_t(L.sw) * L.sh, 0);
-    const Sweep sweep{L, C, occ.data(), snap, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
+    const Sweep sweep{L, C, occ.data(), snap, snap_slot, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
                       p * L.src->channels()};
-    parallel_rows(L.th, band_rows(L.th), [&](int y0, int y1) {
+    parallel_rows(L.th, band, [&](int y0, int y1) {
       Band band;
       auto buf = pool.take();
       band.delta = buf.data();

@@ -181,7 +181,8 @@ struct Level {
   int sw = 0, sh = 0, tw = 0, th = 0;
   Image<int16_t> src;       // sw x sh features
   Image<int16_t> tgt;       // padded target features
-  Image<float> src_style;   // sw x sh style values, for voting
+  Image<float> src_style;   // sw x sh style values for voting (coarse levels; the finest
+                            // votes from the input itself)
   Image<uint8_t> active;    // tw x th, or empty
 };
 
@@ -285,22 +286,42 @@ Image<int32_t> random_nnf(int tw, int th, int sw, int sh, int r, uint64_t seed) 
 
 }  // namespace
 
-Result synthesize(const Inputs& in, const Params& params, const OutputRequest& request) {
+struct Synthesizer::State {
+  Params params;
+  Plane style;
+  std::optional<Plane> mask;
+  int sw = 0, sh = 0, tw = 0, th = 0, levels = 0, border = 0;
+  FeatureLayout layout;
+  std::vector<LevelSchedule> schedule;
+  std::vector<Level> pyr;
+  bool ran = false;
+};
+
+Synthesizer::~Synthesizer() = default;
+
+Synthesizer::Synthesizer(const Inputs& in, const Params& params) : state_(std::make_unique<State>()) {
   validate(in, params);
+  State& st = *state_;
+  st.params = params;
+  st.style = in.style;
+  st.mask = in.target_mask;
   const int p = params.patch_size, r = p / 2;
-  const int border = r;
-  const int sw = plane_width(in.style), sh = plane_height(in.style);
-  const int tw = plane_width(in.guides[0].target), th = plane_height(in.guides[0].target);
-  const FeatureLayout layout = make_layout(in, params);
+  const int border = st.border = r;
+  const int sw = st.sw = plane_width(in.style), sh = st.sh = plane_height(in.style);
+  const int tw = st.tw = plane_width(in.guides[0].target);
+  const int th = st.th = plane_height(in.guides[0].target);
+  st.layout = make_layout(in, params);
+  const FeatureLayout& layout = st.layout;
   const int ns = layout.style_channels;
-  const PatchSsdFn ssd = best_patch_ssd();
 
   int levels = max_pyramid_levels(sw, sh, tw, th, p);
   if (params.pyramid_levels > 0) levels = std::min(levels, params.pyramid_levels);
-  const std::vector<LevelSchedule> schedule = make_schedule(params, levels);
+  st.levels = levels;
+  st.schedule = make_schedule(params, levels);
 
-  // Finest level (index 0) from the inputs; coarser ones by low-pass halving.
-  std::vector<Level> pyr(levels);
+  // Finest level (index 0) from the inputs; coarser ones by halving.
+  std::vector<Level>& pyr = st.pyr;
+  pyr.resize(levels);
   {
     Level& f = pyr[0];
     f.sw = sw, f.sh = sh, f.tw = tw, f.th = th;
@@ -314,10 +335,6 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
       c += plane_channels(g.source);
     }
     pad_replicate(f.tgt, border, ns, layout.channels);
-    f.src_style.reset(sw, sh, ns);
-    for_each_row(in.style, 0, sh, [&](int y, const float* row) {
-      std::copy(row, row + std::size_t(sw) * ns, f.src_style.row(y));
-    });
     if (in.target_mask) {
       // Synthesize the mask dilated by the patch radius, so pixels at its edge get whole patches.
       Image<uint8_t> inside(tw, th, 1);
@@ -343,8 +360,16 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
     const Level& f = pyr[l - 1];
     c.src = downsample(f.src.cview());
     decimate_channels(f.src.cview(), c.src, 0, ns);
-    c.src_style = downsample(f.src_style.cview());
-    decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
+    c.src_style.reset(c.src.width(), c.src.height(), ns);
+    if (l == 1) {
+      for_each_row(in.style, 0, sh, [&](int y, const float* row) {
+        if (y % 2 != 0 || y / 2 >= c.src_style.height()) return;
+        for (int x = 0; x < c.src_style.width(); ++x)
+          for (int k = 0; k < ns; ++k) c.src_style(x, y / 2, k) = row[std::min(2 * x, sw - 1) * ns + k];
+      });
+    } else {
+      decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
+    }
     Image<int16_t> t = downsample(interior(f.tgt, border));
     c.sw = c.src.width(), c.sh = c.src.height(), c.tw = t.width(), c.th = t.height();
     c.tgt.reset(c.tw + 2 * border, c.th + 2 * border, layout.channels);
@@ -353,13 +378,29 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
     pad_replicate(c.tgt, border, ns, layout.channels);
     if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
   }
+}
+
+Result Synthesizer::run(const OutputRequest& request) {
+  State& st = *state_;
+  CHECK(!st.ran);  // the pyramid is consumed by a run
+  st.ran = true;
+  const Params& params = st.params;
+  const FeatureLayout& layout = st.layout;
+  const int ns = layout.style_channels;
+  const int p = params.patch_size, r = p / 2, border = st.border;
+  const int tw = st.tw, th = st.th, levels = st.levels;
+  const PatchSsdFn ssd = best_patch_ssd();
+  std::vector<Level>& pyr = st.pyr;
+  const std::vector<LevelSchedule>& schedule = st.schedule;
 
   Image<int32_t> nnf;
   Image<float> err;
   Image<float> style;
-  auto run_level = [&](Level& L, int level_index, const LevelSchedule& sch, int patch,
+  auto source_style = [&](const Level& L, int l) -> Plane {
+    return l == 0 ? st.style : Plane(L.src_style.cview());
+  };
+  auto run_level = [&](Level& L, int l, int step, const LevelSchedule& sch, int patch,
                        float uniformity) {
-    const int pr = patch / 2;
     PatchMatchLevel pm{L.sw, L.sh, L.tw, L.th, border, &L.src, &L.tgt, &L.active, &nnf, &err};
     if (err.width() != L.tw || err.height() != L.th) err.reset(L.tw, L.th, 1);
     PatchMatchConfig cfg;
@@ -370,13 +411,12 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
     cfg.err_scale = layout.err_scale;
     cfg.ssd = ssd;
     for (int it = 0; it < sch.search_vote_iters; ++it) {
-      cfg.seed = hash_key(params.seed, uint64_t(level_index), uint64_t(it), uint64_t(patch));
+      cfg.seed = hash_key(params.seed, uint64_t(step), uint64_t(it), uint64_t(patch));
       compute_errors(pm, cfg);
       run_patch_match(pm, cfg);
-      vote(L.src_style.cview(), nnf, err, L.active, patch, params.vote_mode, style);
+      vote(source_style(L, l), nnf, err, L.active, patch, params.vote_mode, style);
       write_style(style, layout, L.tgt, border);
     }
-    (void)pr;
   };
 
   for (int l = levels - 1; l >= 0; --l) {
@@ -385,28 +425,25 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
     if (l == levels - 1) nnf = random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
     else nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
     err.reset(L.tw, L.th, 1);
-    vote(L.src_style.cview(), nnf, err, L.active, p, VoteMode::kPlain, style);
+    vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
     write_style(style, layout, L.tgt, border);
-    run_level(L, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
+    run_level(L, l, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
     if (l > 0) pyr[l] = Level();  // free the coarse level
   }
-  if (params.extra_pass_3x3) {
-    LevelSchedule s = schedule.back();
-    run_level(pyr[0], levels, s, 3, 0.0f);
-  }
+  if (params.extra_pass_3x3) run_level(pyr[0], 0, levels, schedule.back(), 3, 0.0f);
 
   Result res;
   res.pyramid_levels = levels;
   res.schedule = schedule;
   const Level& F = pyr[0];
-  const int out_c = ns + (in.target_mask ? 1 : 0);
+  const int out_c = ns + (st.mask ? 1 : 0);
   res.image.reset(tw, th, out_c);
   for (int y = 0; y < th; ++y)
     for (int x = 0; x < tw; ++x)
       for (int c = 0; c < ns; ++c) res.image(x, y, c) = style(x, y, c);
-  if (in.target_mask) {
-    for_each_row(*in.target_mask, 0, th, [&](int y, const float* row) {
-      const int mc = plane_channels(*in.target_mask);
+  if (st.mask) {
+    for_each_row(*st.mask, 0, th, [&](int y, const float* row) {
+      const int mc = plane_channels(*st.mask);
       for (int x = 0; x < tw; ++x) {
         const float a = std::clamp(row[x * mc], 0.0f, 1.0f);
         res.image(x, y, ns) = a;
@@ -434,6 +471,11 @@ Result synthesize(const Inputs& in, const Params& params, const OutputRequest& r
     res.error = std::move(err);
   }
   return res;
+}
+
+Result synthesize(const Inputs& inputs, const Params& params, const OutputRequest& request) {
+  Synthesizer s(inputs, params);
+  return s.run(request);
 }
 
 }  // namespace emaki::synth

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -99,6 +100,23 @@ void validate(const Inputs& inputs, const Params& params);
 std::vector<LevelSchedule> make_schedule(const Params& params, int levels);
 int max_pyramid_levels(int sw, int sh, int tw, int th, int patch_size);
 
+// Two phases, so a caller can free the guide images once they are packed into the engine's own
+// features: the constructor validates and builds the pyramid (it reads every input); run()
+// reads only inputs.style and inputs.target_mask again, which must outlive it.
+class Synthesizer {
+ public:
+  Synthesizer(const Inputs& inputs, const Params& params);
+  ~Synthesizer();
+  Synthesizer(const Synthesizer&) = delete;
+  Synthesizer& operator=(const Synthesizer&) = delete;
+  Result run(const OutputRequest& request = {});
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Both phases at once.
 Result synthesize(const Inputs& inputs, const Params& params, const OutputRequest& request = {});
 
 }  // namespace emaki::synth

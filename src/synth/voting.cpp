@@ -1,13 +1,23 @@
 #include "synth/voting.h"
 
+#include <type_traits>
 #include <vector>
 
 #include "core/parallel.h"
 
 namespace emaki::synth {
 
-void vote(ImageView<const float> source, const Image<int32_t>& nnf, const Image<float>& err,
-          const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out) {
+namespace {
+template <typename T>
+inline float norm(T v) {
+  if constexpr (std::is_same_v<T, uint8_t>) return float(v) * (1.0f / 255.0f);
+  else if constexpr (std::is_same_v<T, uint16_t>) return float(v) * (1.0f / 65535.0f);
+  else return float(v);
+}
+
+template <typename T>
+void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image<float>& err,
+               const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out) {
   const int tw = nnf.width(), th = nnf.height(), nc = source.channels;
   const int r = patch_size / 2;
   if (out.width() != tw || out.height() != th || out.channels() != nc) out.reset(tw, th, nc);
@@ -32,9 +42,9 @@ void vote(ImageView<const float> source, const Image<int32_t>& nnf, const Image<
             const int ux = x + ox;
             if (ux < 0 || ux >= tw || (!all && !active(ux, uy))) continue;
             const int32_t* m = nnf.at(ux, uy);
-            const float* s = source.at(m[0] - ox, m[1] - oy);
+            const T* s = source.at(m[0] - ox, m[1] - oy);
             const float w = mode == VoteMode::kPlain ? 1.0f : 1.0f / (1.0f + err(ux, uy) * err_norm);
-            for (int c = 0; c < nc; ++c) acc[c] += w * s[c];
+            for (int c = 0; c < nc; ++c) acc[c] += w * norm(s[c]);
             wsum += w;
           }
         }
@@ -42,6 +52,13 @@ void vote(ImageView<const float> source, const Image<int32_t>& nnf, const Image<
         for (int c = 0; c < nc; ++c) o[c] = acc[c] * inv;
       }
   });
+}
+
+}  // namespace
+
+void vote(const Plane& source, const Image<int32_t>& nnf, const Image<float>& err,
+          const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out) {
+  std::visit([&](const auto& v) { vote_impl(v, nnf, err, active, patch_size, mode, out); }, source);
 }
 
 }  // namespace emaki::synth

@@ -7,9 +7,10 @@
 
 namespace emaki::synth {
 
+// source: the style exemplar at this level (integer samples mean [0, 1]).
 // nnf: tw x th x 2 source patch centres; err: patch errors (used by kWeighted); active: tw x th
 // or empty. Writes `out` (tw x th x source channels); inactive pixels get 0.
-void vote(ImageView<const float> source, const Image<int32_t>& nnf, const Image<float>& err,
+void vote(const Plane& source, const Image<int32_t>& nnf, const Image<float>& err,
           const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out);
 
 }  // namespace emaki::synth
