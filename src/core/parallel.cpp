@@ -18,6 +18,10 @@ std::unique_ptr<tbb::task_arena> g_arena;
 
 tbb::task_arena& arena() {
   std::lock_guard lock(g_mutex);
+  // Without this, TBB sizes its worker pool by the first arena it sees: a first run with one
+  // thread would cap every later run at one. Allowing plenty lets each arena get what it asks.
+  static tbb::global_control allow(tbb::global_control::max_allowed_parallelism,
+                                   std::max<std::size_t>(64, tbb::this_task_arena::max_concurrency()));
   if (!g_arena) {
     const int n = g_threads > 0 ? g_threads : tbb::this_task_arena::max_concurrency();
     g_arena = std::make_unique<tbb::task_arena>(n);

@@ -25,7 +25,9 @@ void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image
   // EbSynth's weighting: error per patch pixel and channel.
   const float err_norm = 1.0f / float(patch_size * patch_size * nc);
   parallel_rows(th, 16, [&](int y0, int y1) {
-    std::vector<float> acc(nc);
+    // Double sums: where every patch agrees the vote returns exactly the source value, so an
+    // exact match stays exact after re-quantisation.
+    std::vector<double> acc(nc);
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < tw; ++x) {
         float* o = out.at(x, y);
@@ -33,8 +35,8 @@ void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image
           for (int c = 0; c < nc; ++c) o[c] = 0.0f;
           continue;
         }
-        std::fill(acc.begin(), acc.end(), 0.0f);
-        float wsum = 0.0f;
+        std::fill(acc.begin(), acc.end(), 0.0);
+        double wsum = 0.0;
         for (int oy = -r; oy <= r; ++oy) {
           const int uy = y + oy;
           if (uy < 0 || uy >= th) continue;
@@ -44,12 +46,12 @@ void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image
             const int32_t* m = nnf.at(ux, uy);
             const T* s = source.at(m[0] - ox, m[1] - oy);
             const float w = mode == VoteMode::kPlain ? 1.0f : 1.0f / (1.0f + err(ux, uy) * err_norm);
-            for (int c = 0; c < nc; ++c) acc[c] += w * norm(s[c]);
+            for (int c = 0; c < nc; ++c) acc[c] += double(w) * norm(s[c]);
             wsum += w;
           }
         }
-        const float inv = 1.0f / wsum;  // the pixel's own patch always counts: wsum > 0
-        for (int c = 0; c < nc; ++c) o[c] = acc[c] * inv;
+        // The pixel's own patch always counts: wsum > 0.
+        for (int c = 0; c < nc; ++c) o[c] = float(acc[c] / wsum);
       }
   });
 }
