@@ -27,7 +27,7 @@ int run_template(const Args& args) {
       "emaki template"};
   std::string out_dir, size = "1024x768", fit, sphere, light = "-1,1,1";
   std::string ground_color = "0.8,0.8,0.8", background = "0,0,0";
-  float elevation = 15.0f, fov = 30.0f, softness = 2.0f, outline_width = 1.5f;
+  float elevation = 10.0f, fov = 30.0f, softness = 2.0f, outline_width = 1.5f;
   float horizon = NAN;
   int aa = 3, threads = 0;
   bool no_ground = false, previews = false, full_float = false;

@@ -105,6 +105,23 @@ TEST(ReferenceSphere, HorizonRowSetsTheElevation) {
   EXPECT_EQ(r.frame(5, 44, render::kObjectId), 1.0f);
 }
 
+// The ground is a huge quad clipped by the near plane and the guard band on both of its
+// triangles; the pieces must meet without cracks (a crack shows as alpha < 1 on open ground).
+TEST(ReferenceSphere, GroundHasNoCracks) {
+  for (float elevation : {15.0f, 10.0f, 30.0f}) {
+    ReferenceSpec spec;
+    spec.width = 300;
+    spec.height = 225;
+    spec.elevation_deg = elevation;
+    const Rendered r = render_reference(spec, 2);
+    int holes = 0;
+    for (int y = spec.height / 2; y < spec.height; ++y)
+      for (int x = 0; x < spec.width; ++x) holes += r.frame(x, y, render::kAlpha) < 1.0f &&
+                                                     r.frame(x, y, render::kObjectId) != 2.0f;
+    EXPECT_EQ(holes, 0) << "elevation " << elevation;
+  }
+}
+
 TEST(ReferenceSphere, PaintTemplateIsGreyAndMarksTheContour) {
   ReferenceSpec spec;
   spec.width = 160;

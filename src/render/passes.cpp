@@ -52,15 +52,19 @@ void hsv(float h, float s, float v, float* rgb) {
 Image<float> preview(ImageView<const float> frame, const PassInfo& pass) {
   const int w = frame.width, h = frame.height;
   Image<float> out(w, h, 3);
-  float lo = 1e30f, hi = -1e30f, max_motion = 1e-6f;
+  // Depth is shown over the range of the scene's objects (the ground can reach the horizon),
+  // or of whatever is covered when there are none.
+  float lo = 1e30f, hi = -1e30f, all_lo = 1e30f, all_hi = -1e30f, max_motion = 1e-6f;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const float* p = frame.at(x, y);
       if (p[kAlpha] <= 0.0f) continue;
-      lo = std::min(lo, p[kDepth]);
-      hi = std::max(hi, p[kDepth]);
+      all_lo = std::min(all_lo, p[kDepth]);
+      all_hi = std::max(all_hi, p[kDepth]);
+      if (p[kObjectId] >= 2.0f) lo = std::min(lo, p[kDepth]), hi = std::max(hi, p[kDepth]);
       max_motion = std::max(max_motion, std::hypot(p[kMotion], p[kMotion + 1]));
     }
+  if (lo > hi) lo = all_lo, hi = all_hi;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const float* p = frame.at(x, y);
@@ -77,7 +81,8 @@ Image<float> preview(ImageView<const float> frame, const PassInfo& pass) {
           for (int c = 0; c < 3; ++c) o[c] = std::clamp(v[c], 0.0f, 1.0f);
           break;
         case kDepth:
-          o[0] = o[1] = o[2] = a > 0 && hi > lo ? 1.0f - 0.9f * (v[0] - lo) / (hi - lo) : 0.0f;
+          o[0] = o[1] = o[2] =
+              a > 0 && hi > lo ? 1.0f - 0.9f * std::clamp((v[0] - lo) / (hi - lo), 0.0f, 1.0f) : 0.0f;
           break;
         case kAlbedo:
           for (int c = 0; c < 3; ++c) o[c] = encode_srgb(v[c]);

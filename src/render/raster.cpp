@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "core/parallel.h"
 
@@ -57,8 +58,14 @@ void clip_polygon(std::vector<PolyVertex>& poly, std::vector<PolyVertex>& scratc
     const float da = dist(a.c), db = dist(b.c);
     if (da >= 0) scratch.push_back(a);
     if ((da >= 0) != (db >= 0)) {
-      const float t = da / (da - db);
-      scratch.push_back({a.c + t * (b.c - a.c), a.bary + t * (b.bary - a.bary)});
+      // Interpolate from the lexicographically smaller end, so the two triangles sharing this
+      // edge (which walk it in opposite directions) compute the very same point: no cracks.
+      const bool a_first = std::tie(a.c.x, a.c.y, a.c.z, a.c.w) < std::tie(b.c.x, b.c.y, b.c.z, b.c.w);
+      const PolyVertex& p = a_first ? a : b;
+      const PolyVertex& q = a_first ? b : a;
+      const float dp = a_first ? da : db, dq = a_first ? db : da;
+      const float t = dp / (dp - dq);
+      scratch.push_back({p.c + t * (q.c - p.c), p.bary + t * (q.bary - p.bary)});
     }
   }
   poly.swap(scratch);
