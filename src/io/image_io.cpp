@@ -1,22 +1,21 @@
 #include "io/image_io.h"
 
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "io/oiio_backend.h"
+#include "io/png_io.h"
 
 namespace emaki::io {
 namespace fs = std::filesystem;
-using OIIO::ImageInput;
-using OIIO::ImageOutput;
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
 
 // ---------------------------------------------------------------------------------------------
 // AnyImage
@@ -79,124 +78,117 @@ AnyImage AnyImage::select_channels(int first, int count) const {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The OpenImageIO plugin
+
+namespace detail {
+
+const OiioBackend& oiio_backend(const std::string& subject) {
+  static const OiioBackend* backend = nullptr;
+  static std::string failure;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::vector<std::string> candidates;
+    if (const char* env = std::getenv("EMAKI_OIIO_MODULE")) candidates.push_back(env);
+    // Beside the executable (installed layouts), then where the build put it.
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+      candidates.push_back((exe.parent_path() / "libemaki_io_oiio.so").string());
+      candidates.push_back((exe.parent_path() / "../lib/emaki/libemaki_io_oiio.so").string());
+    }
+#ifdef EMAKI_OIIO_MODULE_PATH
+    candidates.push_back(EMAKI_OIIO_MODULE_PATH);
+#endif
+    for (const auto& c : candidates) {
+      if (!fs::exists(c, ec)) continue;
+      void* h = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!h) {
+        failure = dlerror();
+        continue;
+      }
+      using Fn = const OiioBackend* (*)();
+      if (auto fn = reinterpret_cast<Fn>(dlsym(h, "emaki_oiio_backend"))) {
+        backend = fn();
+        return;
+      }
+    }
+    if (failure.empty()) failure = "libemaki_io_oiio.so not found";
+  });
+  if (!backend) throw Error(subject, "cannot load the OpenImageIO plugin (" + failure + ")");
+  return *backend;
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------------------------------------
 // Reading
 
 namespace {
 
-std::string oiio_error(const std::string& fallback) {
-  std::string e = OIIO::geterror();
-  if (e.empty()) return fallback;
-  // One line: keep the first line of OIIO's message.
-  if (auto nl = e.find('\n'); nl != std::string::npos) e.resize(nl);
+std::string lower_ext(const std::string& path) {
+  std::string e = fs::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
   return e;
 }
 
-std::unique_ptr<ImageInput> open_input(const std::string& path) {
+void check_readable(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error(path, "file not found");
   if (fs::is_directory(path, ec)) throw Error(path, "is a folder, not an image file");
-  auto in = ImageInput::open(path);
-  if (!in) throw Error(path, "cannot read image (" + oiio_error("unknown format") + ")");
-  return in;
 }
 
-template <typename T>
-void read_into(ImageInput& in, const std::string& path, int subimage, int chbegin, int chend,
-               Image<T>& out, int dst_channel_offset, TypeDesc type) {
-  const ImageSpec& spec = in.spec();
-  const int nch = chend - chbegin;
-  std::vector<T> buf(std::size_t(spec.width) * spec.height * nch);
-  if (!in.read_image(subimage, 0, chbegin, chend, type, buf.data()))
-    throw Error(path, "corrupt or truncated image (" + oiio_error(in.geterror()) + ")");
-  for (int y = 0; y < spec.height; ++y)
-    for (int x = 0; x < spec.width; ++x)
-      for (int c = 0; c < nch; ++c)
-        out(x, y, dst_channel_offset + c) = buf[(std::size_t(y) * spec.width + x) * nch + c];
-}
-
-void check_finite(const Image<float>& im, const std::string& path) {
-  for (int y = 0; y < im.height(); ++y) {
-    const float* r = im.row(y);
-    for (int i = 0; i < im.width() * im.channels(); ++i)
-      if (!std::isfinite(r[i]))
-        throw Error(path, fmt::format("non-finite value (NaN or Inf) at pixel ({}, {}) channel {}",
-                                      i / im.channels(), y, i % im.channels()));
-  }
+bool is_png(const std::string& path) {
+  unsigned char sig[8] = {};
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  const std::size_t n = std::fread(sig, 1, 8, f);
+  std::fclose(f);
+  static const unsigned char kSig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return n == 8 && std::equal(sig, sig + 8, kSig);
 }
 
 }  // namespace
 
 std::vector<std::string> list_channels(const std::string& path) {
-  auto in = open_input(path);
+  check_readable(path);
+  if (is_png(path)) return detail::read_png(path).channel_names;
   std::vector<std::string> names;
-  for (int sub = 0; in->seek_subimage(sub, 0); ++sub)
-    for (const auto& n : in->spec().channelnames) names.push_back(n);
+  if (std::string e = detail::oiio_backend(path).list_channels(path, names); !e.empty())
+    throw Error(path, e);
   return names;
 }
 
 AnyImage read_image(const std::string& path, const ReadOptions& options) {
-  auto in = open_input(path);
+  check_readable(path);
   AnyImage result;
-  if (options.channels.empty()) {
-    const ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0) throw Error(path, "image has no pixels");
-    const int nch = spec.nchannels;
-    const TypeDesc::BASETYPE bt = TypeDesc::BASETYPE(spec.format.basetype);
-    if (bt == TypeDesc::UINT8 || bt == TypeDesc::INT8) {
-      Image<uint8_t> im(spec.width, spec.height, nch);
-      read_into(*in, path, 0, 0, nch, im, 0, TypeDesc::UINT8);
-      result.image = std::move(im);
-    } else if (bt == TypeDesc::UINT16 || bt == TypeDesc::INT16) {
-      Image<uint16_t> im(spec.width, spec.height, nch);
-      read_into(*in, path, 0, 0, nch, im, 0, TypeDesc::UINT16);
-      result.image = std::move(im);
-    } else {
-      Image<float> im(spec.width, spec.height, nch);
-      read_into(*in, path, 0, 0, nch, im, 0, TypeDesc::FLOAT);
-      check_finite(im, path);
-      result.image = std::move(im);
+  if (is_png(path) || lower_ext(path) == ".png") {
+    result = detail::read_png(path);
+    if (!options.channels.empty()) {
+      // Pick channels by name from the PNG's R, G, B, A / Y, A.
+      AnyImage picked;
+      std::vector<int> idx;
+      for (const auto& want : options.channels) {
+        auto it = std::find(result.channel_names.begin(), result.channel_names.end(), want);
+        if (it == result.channel_names.end()) {
+          std::string list;
+          for (const auto& n : result.channel_names) list += (list.empty() ? "" : ", ") + n;
+          throw Error(path, "no channel '" + want + "' (the file has: " + list + ")");
+        }
+        idx.push_back(int(it - result.channel_names.begin()));
+      }
+      Image<float> f = result.to_float();
+      Image<float> o(f.width(), f.height(), int(idx.size()));
+      for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x)
+          for (std::size_t k = 0; k < idx.size(); ++k) o(x, y, int(k)) = f(x, y, idx[k]);
+      picked.image = std::move(o);
+      picked.channel_names = options.channels;
+      return picked;
     }
-    result.channel_names = spec.channelnames;
     return result;
   }
-
-  // Named channels: gather from whichever part holds each, as float.
-  struct Where {
-    int sub, ch;
-  };
-  std::vector<Where> where;
-  std::vector<std::string> available;
-  int width = -1, height = -1;
-  for (const auto& want : options.channels) {
-    bool found = false;
-    for (int sub = 0; in->seek_subimage(sub, 0) && !found; ++sub) {
-      const auto& spec = in->spec();
-      for (int c = 0; c < spec.nchannels; ++c) {
-        if (spec.channelnames[c] == want) {
-          where.push_back({sub, c});
-          if (width < 0) width = spec.width, height = spec.height;
-          else if (spec.width != width || spec.height != height)
-            throw Error(path, "channel '" + want + "' has a different size from the others");
-          found = true;
-          break;
-        }
-      }
-    }
-    if (!found) {
-      available = list_channels(path);
-      std::string list;
-      for (const auto& a : available) list += (list.empty() ? "" : ", ") + a;
-      throw Error(path, "no channel '" + want + "' (the file has: " + list + ")");
-    }
-  }
-  Image<float> im(width, height, int(where.size()));
-  for (std::size_t i = 0; i < where.size(); ++i) {
-    in->seek_subimage(where[i].sub, 0);
-    read_into(*in, path, where[i].sub, where[i].ch, where[i].ch + 1, im, int(i), TypeDesc::FLOAT);
-  }
-  check_finite(im, path);
-  result.image = std::move(im);
-  result.channel_names = options.channels;
+  if (std::string e = detail::oiio_backend(path).read(path, options, result); !e.empty())
+    throw Error(path, e);
   return result;
 }
 
@@ -206,14 +198,6 @@ Image<float> read_image_float(const std::string& path, const ReadOptions& option
 
 // ---------------------------------------------------------------------------------------------
 // Writing
-
-namespace {
-std::string lower_ext(const std::string& path) {
-  std::string e = fs::path(path).extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
-}  // namespace
 
 bool is_writable_extension(const std::string& path) {
   const std::string e = lower_ext(path);
@@ -236,57 +220,45 @@ void write_image(const std::string& path, ImageView<const float> image,
                  const WriteOptions& options) {
   check_writable(path);
   const std::string ext = lower_ext(path);
-  TypeDesc type = TypeDesc::UINT16;
+  // 0 u8, 1 u16, 2 half, 3 float
+  int type = 1;
   switch (options.format) {
-    case SampleFormat::kU8: type = TypeDesc::UINT8; break;
-    case SampleFormat::kU16: type = TypeDesc::UINT16; break;
-    case SampleFormat::kHalf: type = TypeDesc::HALF; break;
-    case SampleFormat::kFloat: type = TypeDesc::FLOAT; break;
-    case SampleFormat::kAuto:
-      type = ext == ".exr" ? TypeDesc::HALF : (ext == ".jpg" || ext == ".jpeg") ? TypeDesc::UINT8
-                                                                                : TypeDesc::UINT16;
+    case SampleFormat::kU8: type = 0; break;
+    case SampleFormat::kU16: type = 1; break;
+    case SampleFormat::kHalf: type = 2; break;
+    case SampleFormat::kFloat: type = 3; break;
+    case SampleFormat::kAuto: type = ext == ".exr" ? 2 : (ext == ".jpg" || ext == ".jpeg") ? 0 : 1;
   }
-  if (ext == ".exr" && (type == TypeDesc::UINT8 || type == TypeDesc::UINT16)) type = TypeDesc::HALF;
-  if ((ext == ".jpg" || ext == ".jpeg")) type = TypeDesc::UINT8;
-  if (ext == ".png" && (type == TypeDesc::HALF || type == TypeDesc::FLOAT)) type = TypeDesc::UINT16;
-
-  ImageSpec spec(image.width, image.height, image.channels, type);
-  if (!options.channel_names.empty()) {
-    CHECK_EQ(int(options.channel_names.size()), image.channels);
-    spec.channelnames = options.channel_names;
-  }
-  if (image.channels == 4 || (image.channels == 2)) spec.alpha_channel = image.channels - 1;
-  if (ext == ".exr") spec.attribute("compression", "zip");
-
-  // Integer formats take values clamped to [0,1]; float formats take them as they are.
-  const bool integer = type == TypeDesc::UINT8 || type == TypeDesc::UINT16;
-  std::vector<float> buf(std::size_t(image.width) * image.height * image.channels);
-  for (int y = 0; y < image.height; ++y) {
-    const float* r = image.row(y);
-    float* d = buf.data() + std::size_t(y) * image.width * image.channels;
-    for (int i = 0; i < image.width * image.channels; ++i)
-      d[i] = integer ? std::clamp(r[i], 0.0f, 1.0f) : r[i];
+  if (ext == ".exr" && type < 2) type = 2;
+  if (ext == ".jpg" || ext == ".jpeg") type = 0;
+  if (ext == ".png" && type > 1) type = 1;
+  if (!options.channel_names.empty()) CHECK_EQ(int(options.channel_names.size()), image.channels);
+  // Integer formats take values clamped to [0, 1]; float formats take them as they are.
+  Image<float> clamped;
+  if (type < 2 && ext != ".png") {
+    clamped.reset(image.width, image.height, image.channels);
+    for (int y = 0; y < image.height; ++y)
+      for (int i = 0; i < image.width * image.channels; ++i)
+        clamped.row(y)[i] = std::clamp(image.row(y)[i], 0.0f, 1.0f);
+    image = clamped.cview();
   }
 
   const fs::path target(path);
   const fs::path tmp = target.parent_path() /
                        fmt::format(".{}.tmp{}{}", target.stem().string(), ::getpid(), ext);
-  {
-    auto out = ImageOutput::create(tmp.string());
-    if (!out) throw Error(path, "cannot create image writer (" + oiio_error("unknown format") + ")");
-    if (!out->open(tmp.string(), spec)) {
-      std::string e = oiio_error(out->geterror());
-      throw Error(path, "cannot open for writing (" + e + ")");
-    }
-    const bool ok = out->write_image(TypeDesc::FLOAT, buf.data());
-    const bool closed = out->close();
-    if (!ok || !closed) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw Error(path, "write failed (" + oiio_error(out->geterror()) + ")");
-    }
-  }
   std::error_code ec;
+  try {
+    if (ext == ".png") {
+      detail::write_png(tmp.string(), image, type == 1, path);
+    } else if (std::string e = detail::oiio_backend(path).write(tmp.string(), image,
+                                                                 options.channel_names, type);
+               !e.empty()) {
+      throw Error(path, e);
+    }
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
   fs::rename(tmp, target, ec);
   if (ec) {
     fs::remove(tmp, ec);
