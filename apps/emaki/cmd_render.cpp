@@ -2,6 +2,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <future>
+#include <memory>
 #include <string>
 
 #include <unistd.h>
@@ -107,13 +109,20 @@ int run_render(const Args& args) {
   const int count = shot.last_frame - shot.first_frame + 1;
   const bool tty = isatty(fileno(stderr));
   const auto start = std::chrono::steady_clock::now();
+  // A frame's files are written while the next frame renders (compressing an EXR is mostly
+  // serial); get() rethrows a write error before anything else is written.
+  std::future<void> writing;
   for (int f = shot.first_frame; f <= shot.last_frame; ++f) {
-    const Image<float> frame = renderer.render(f);
-    if (render::object_coverage(frame.cview()) == 0.0f)
+    auto frame = std::make_shared<Image<float>>(renderer.render(f));
+    if (render::object_coverage(frame->cview()) == 0.0f)
       throw Error(scene_path, fmt::format("frame {}: the camera sees nothing of the scene (all "
                                           "background); check --camera, --target and --fov", f));
+    if (writing.valid()) writing.get();
     const std::string stem = fmt::format("frame_{:04d}", f);
-    write_frame(frame, dir / (stem + ".exr"), preview_dir, stem, !full_float);
+    writing = std::async(std::launch::async, [frame, path = dir / (stem + ".exr"), preview_dir,
+                                              stem, half = !full_float] {
+      write_frame(*frame, path, preview_dir, stem, half);
+    });
     if (!quiet) {
       const int done = f - shot.first_frame + 1;
       const double elapsed =
@@ -125,6 +134,7 @@ int run_render(const Args& args) {
       std::fflush(stderr);
     }
   }
+  if (writing.valid()) writing.get();
   if (!quiet)
     std::fprintf(stderr, "emaki render: wrote %d frame(s) to %s\n", count, dir.string().c_str());
   return 0;
