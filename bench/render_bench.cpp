@@ -31,10 +31,11 @@ int main(int argc, char** argv) {
     for (int i = 0; i < frames; ++i) renderer.render(1 + i % 16);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("render_bench: %s %dx%d aa %dx%d, %d passes (%d channels), %d threads: "
-                "%.3f s/frame over %d frames\n",
-                path.c_str(), options.width, options.height, options.aa, options.aa, 13,
-                render::kChannelCount, thread_count(), seconds / frames, frames);
+    std::printf(
+        "render_bench: %s %dx%d aa %dx%d, %d passes (%d channels), %d threads: "
+        "%.3f s/frame over %d frames\n",
+        path.c_str(), options.width, options.height, options.aa, options.aa, 13,
+        render::kChannelCount, thread_count(), seconds / frames, frames);
   } catch (const Error& e) {
     std::fprintf(stderr, "render_bench: %s\n", e.what());
     return 1;

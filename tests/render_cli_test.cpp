@@ -1,7 +1,6 @@
 // End-to-end tests of `emaki render` / `emaki template`: outputs on good input; on bad input one
 // line on stderr naming the file and the problem, a non-zero exit, and no EXR left behind.
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -39,7 +38,8 @@ class RenderCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("emaki_render_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("emaki_render_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -58,7 +58,8 @@ class RenderCli : public ::testing::Test {
     return n;
   }
   // The failure contract: non-zero exit, exactly one line naming `subject` and `what`, no EXR.
-  void expect_failure(const std::string& args, const std::string& subject, const std::string& what) {
+  void expect_failure(const std::string& args, const std::string& subject,
+                      const std::string& what) {
     const Outcome r = run(args);
     EXPECT_NE(r.exit_code, 0) << r.output;
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
@@ -87,8 +88,9 @@ const char* kTriangleData =
     "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA";
 
 TEST_F(RenderCli, RendersFoxFramesWithAllChannels) {
-  const Outcome r = run("render " + kScenes + "Fox.glb --clip Walk --frames 2-3 --size 96x54 --out " + out() +
-                    " --previews");
+  const Outcome r =
+      run("render " + kScenes + "Fox.glb --clip Walk --frames 2-3 --size 96x54 --out " + out() +
+          " --previews");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* f : {"frame_0002.exr", "frame_0003.exr"}) {
     const std::vector<std::string> names = emaki::io::list_channels((dir_ / "out" / f).string());
@@ -121,7 +123,8 @@ TEST_F(RenderCli, TruncatedGlb) {
   std::string head(4000, '\0');
   in.read(head.data(), head.size());
   const std::string scene = write("truncated.glb", head);
-  expect_failure("render " + scene + " --size 64x48 --out " + out(), "truncated.glb", "not a valid glTF");
+  expect_failure("render " + scene + " --size 64x48 --out " + out(), "truncated.glb",
+                 "not a valid glTF");
 }
 
 TEST_F(RenderCli, TextureThatDoesNotDecode) {
@@ -133,27 +136,34 @@ TEST_F(RenderCli, TextureThatDoesNotDecode) {
 }
 
 TEST_F(RenderCli, EmptyScene) {
-  const std::string scene = write(
-      "empty.gltf", R"({"asset":{"version":"2.0"},"nodes":[{}],"scenes":[{"nodes":[0]}],"scene":0})");
-  expect_failure("render " + scene + " --size 64x48 --out " + out(), "empty.gltf", "no triangle mesh");
+  const std::string scene =
+      write("empty.gltf",
+            R"({"asset":{"version":"2.0"},"nodes":[{}],"scenes":[{"nodes":[0]}],"scene":0})");
+  expect_failure("render " + scene + " --size 64x48 --out " + out(), "empty.gltf",
+                 "no triangle mesh");
 }
 
 TEST_F(RenderCli, FrameRangeOutsideTheClip) {
-  expect_failure("render " + kScenes + "Fox.glb --clip Walk --frames 0-500 --size 64x48 --out " + out(),
-                 "--frames", "past the end of clip 'Walk'");
+  expect_failure(
+      "render " + kScenes + "Fox.glb --clip Walk --frames 0-500 --size 64x48 --out " + out(),
+      "--frames", "past the end of clip 'Walk'");
 }
 
 TEST_F(RenderCli, CameraSeesNothing) {
-  expect_failure("render " + kScenes + "Fox.glb --frames 0-2 --camera 0,50,5000 --target 0,50,10000 --size 64x48 --out " + out(),
-                 "Fox.glb", "all background");
+  expect_failure(
+      "render " + kScenes +
+          "Fox.glb --frames 0-2 --camera 0,50,5000 --target 0,50,10000 --size 64x48 --out " + out(),
+      "Fox.glb", "all background");
 }
 
 TEST_F(RenderCli, MissingFile) {
-  expect_failure("render " + (dir_ / "nope.glb").string() + " --out " + out(), "nope.glb", "no such file");
+  expect_failure("render " + (dir_ / "nope.glb").string() + " --out " + out(), "nope.glb",
+                 "no such file");
 }
 
 TEST_F(RenderCli, BadSizeNamesTheOption) {
-  expect_failure("render " + kScenes + "Fox.glb --size 64by48 --out " + out(), "--size", "WIDTHxHEIGHT");
+  expect_failure("render " + kScenes + "Fox.glb --size 64by48 --out " + out(), "--size",
+                 "WIDTHxHEIGHT");
 }
 
 TEST_F(RenderCli, TemplateWritesPassesAndPaintTemplate) {

@@ -1,14 +1,13 @@
 // `emaki render`: a glTF scene's guide passes, one multilayer EXR per frame.
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <future>
 #include <memory>
 #include <string>
-
-#include <unistd.h>
-
-#include <fmt/format.h>
 
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_options.h"
@@ -62,7 +61,8 @@ void write_frame(const Image<float>& frame, const fs::path& exr, const fs::path&
     const Image<float> p = render::preview(frame.cview(), pass);
     io::WriteOptions po;
     po.format = io::SampleFormat::kU8;
-    io::write_image((preview_dir / fmt::format("{}_{}.png", stem, pass.name)).string(), p.cview(), po);
+    io::write_image((preview_dir / fmt::format("{}_{}.png", stem, pass.name)).string(), p.cview(),
+                    po);
   }
 }
 
@@ -81,9 +81,12 @@ int run_render(const Args& args) {
       ->capture_default_str();
   app.add_option("--out", out_dir, "output folder (created if missing)")->required();
   app.add_option("--clip", clip, "animation clip by name; default: the first clip");
-  app.add_option("--fps", fps, "frames per second, > 0")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--fps", fps, "frames per second, > 0")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   so.add_to(app, true);
-  app.add_flag("--previews", previews, "also write DIR/preview/frame_NNNN_<pass>.png for every pass");
+  app.add_flag("--previews", previews,
+               "also write DIR/preview/frame_NNNN_<pass>.png for every pass");
   app.add_flag("--float", full_float, "32-bit float EXR channels (default: half)");
   app.add_flag("--quiet", quiet, "no progress on stderr");
   if (parse_cli(app, args)) return 0;
@@ -116,7 +119,8 @@ int run_render(const Args& args) {
     auto frame = std::make_shared<Image<float>>(renderer.render(f));
     if (render::object_coverage(frame->cview()) == 0.0f)
       throw Error(scene_path, fmt::format("frame {}: the camera sees nothing of the scene (all "
-                                          "background); check --camera, --target and --fov", f));
+                                          "background); check --camera, --target and --fov",
+                                          f));
     if (writing.valid()) writing.get();
     const std::string stem = fmt::format("frame_{:04d}", f);
     writing = std::async(std::launch::async, [frame, path = dir / (stem + ".exr"), preview_dir,

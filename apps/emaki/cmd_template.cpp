@@ -1,11 +1,11 @@
 // `emaki template`: the reference sphere's passes and a paint template, or passes fitted to a
 // sphere that is already painted (--fit PAINTING --sphere CX,CY,R).
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_options.h"
@@ -43,7 +43,8 @@ int run_template(const Args& args) {
       ->capture_default_str();
   app.add_option("--horizon", horizon,
                  "image row of the ground's horizon; sets the elevation instead of --elevation");
-  app.add_option("--fov", fov, "vertical field of view, degrees, [1, 120]; small = nearly orthographic")
+  app.add_option("--fov", fov,
+                 "vertical field of view, degrees, [1, 120]; small = nearly orthographic")
       ->check(CLI::Range(1.0f, 120.0f))
       ->capture_default_str();
   app.add_option("--light", light,
@@ -64,7 +65,8 @@ int run_template(const Args& args) {
   app.add_option("--outline-width", outline_width, "outline width in pixels, [0, 16]")
       ->check(CLI::Range(0.0f, 16.0f))
       ->capture_default_str();
-  app.add_flag("--previews", previews, "also write DIR/preview/reference_<pass>.png for every pass");
+  app.add_flag("--previews", previews,
+               "also write DIR/preview/reference_<pass>.png for every pass");
   app.add_flag("--float", full_float, "32-bit float EXR channels (default: half)");
   app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores")
       ->check(CLI::NonNegativeNumber)
@@ -113,7 +115,8 @@ int run_template(const Args& args) {
   const fs::path dir(out_dir);
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir)) throw Error("--out", fmt::format("cannot create folder '{}'", out_dir));
+  if (!fs::is_directory(dir))
+    throw Error("--out", fmt::format("cannot create folder '{}'", out_dir));
   io::check_writable((dir / "reference.exr").string());
   fs::path preview_dir;
   if (previews) {

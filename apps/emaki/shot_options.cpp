@@ -1,10 +1,10 @@
 #include "apps/emaki/shot_options.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -78,8 +78,10 @@ void ShotOptions::add_to(CLI::App& app, bool with_motion) {
   app.add_option("--camera", camera,
                  "camera position X,Y,Z (world); default: placed by --azimuth/--elevation/"
                  "--distance around the subject");
-  app.add_option("--target", target, "point the camera looks at X,Y,Z; default: the subject's centre");
-  app.add_option("--azimuth", azimuth, "automatic camera: degrees around +Y, 0 = from +Z, any value")
+  app.add_option("--target", target,
+                 "point the camera looks at X,Y,Z; default: the subject's centre");
+  app.add_option("--azimuth", azimuth,
+                 "automatic camera: degrees around +Y, 0 = from +Z, any value")
       ->capture_default_str();
   app.add_option("--elevation", elevation, "automatic camera: degrees above the horizon, [-89, 89]")
       ->check(CLI::Range(-89.0f, 89.0f))
@@ -91,8 +93,9 @@ void ShotOptions::add_to(CLI::App& app, bool with_motion) {
   app.add_option("--fov", fov, "vertical field of view, degrees, [1, 170]")
       ->check(CLI::Range(1.0f, 170.0f))
       ->capture_default_str();
-  app.add_option("--ortho", ortho,
-                 "orthographic camera showing this many scene units vertically, >= 0; 0 = perspective")
+  app.add_option(
+         "--ortho", ortho,
+         "orthographic camera showing this many scene units vertically, >= 0; 0 = perspective")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   if (with_motion) {

@@ -2,11 +2,10 @@
 // (camera, light, ground, background) and the renderer settings, bound to a CLI11 app.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "apps/emaki/commands.h"
 #include "render/renderer.h"

@@ -1,9 +1,9 @@
 #include "exemplar/reference_sphere.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "render/passes.h"
@@ -23,7 +23,8 @@ scene::Scene sphere_scene(int rings) {
     const float theta = kPi * r / rings;  // from the top
     for (int s = 0; s <= segments; ++s) {
       const float phi = 2.0f * kPi * s / segments;
-      const glm::vec3 n(std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi));
+      const glm::vec3 n(std::sin(theta) * std::sin(phi), std::cos(theta),
+                        std::sin(theta) * std::cos(phi));
       p.positions.push_back(n + glm::vec3(0.0f, 1.0f, 0.0f));
       p.normals.push_back(n);
       p.uvs.push_back({float(s) / segments, float(r) / rings});

@@ -49,8 +49,8 @@ TEST(ReferenceSphere, NormalPassMatchesAnalyticNormals) {
       if (std::hypot(x + 0.5f - circle.x, y + 0.5f - circle.y) > circle.z - 2.0f) continue;
       const float nx = (x + 0.5f) / spec.width * 2 - 1 - cam.shift.x;
       const float ny = 1 - (y + 0.5f) / spec.height * 2 - cam.shift.y;
-      const glm::vec3 d = glm::normalize(
-          glm::vec3(nx * cam.tan_half_fov * aspect, ny * cam.tan_half_fov, -1.0f));
+      const glm::vec3 d =
+          glm::normalize(glm::vec3(nx * cam.tan_half_fov * aspect, ny * cam.tan_half_fov, -1.0f));
       const float b = glm::dot(d, centre);
       const float disc = b * b - (glm::dot(centre, centre) - 1.0f);
       ASSERT_GT(disc, 0.0f) << "pixel " << x << "," << y << " misses the analytic sphere";
@@ -58,7 +58,8 @@ TEST(ReferenceSphere, NormalPassMatchesAnalyticNormals) {
       const glm::vec3 exact = glm::normalize(hit - centre);
       const glm::vec3 pass(p[render::kNormal], p[render::kNormal + 1], p[render::kNormal + 2]);
       const double angle =
-          std::acos(std::clamp(double(glm::dot(exact, glm::normalize(pass))), -1.0, 1.0)) * 180 / kPi;
+          std::acos(std::clamp(double(glm::dot(exact, glm::normalize(pass))), -1.0, 1.0)) * 180 /
+          kPi;
       sum += angle;
       worst = std::max(worst, angle);
       ++n;
@@ -116,8 +117,8 @@ TEST(ReferenceSphere, GroundHasNoCracks) {
     const Rendered r = render_reference(spec, 2);
     int holes = 0;
     for (int y = spec.height / 2; y < spec.height; ++y)
-      for (int x = 0; x < spec.width; ++x) holes += r.frame(x, y, render::kAlpha) < 1.0f &&
-                                                     r.frame(x, y, render::kObjectId) != 2.0f;
+      for (int x = 0; x < spec.width; ++x)
+        holes += r.frame(x, y, render::kAlpha) < 1.0f && r.frame(x, y, render::kObjectId) != 2.0f;
     EXPECT_EQ(holes, 0) << "elevation " << elevation;
   }
 }

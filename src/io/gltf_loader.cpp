@@ -1,13 +1,12 @@
 #include "io/gltf_loader.h"
 
+#include <fmt/format.h>
 #include <tiny_gltf.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 
@@ -37,7 +36,8 @@ class Loader {
 
   // Reads an accessor into floats (normalised integers mapped to [0,1] / [-1,1]), checking
   // every byte it touches lies inside its buffer view and buffer.
-  std::vector<float> read_floats(int index, int expected_components, const std::string& what) const {
+  std::vector<float> read_floats(int index, int expected_components,
+                                 const std::string& what) const {
     const tinygltf::Accessor& acc = accessor(index, what);
     const int comps = tinygltf::GetNumComponentsInType(acc.type);
     if (expected_components > 0 && comps != expected_components)
@@ -65,7 +65,9 @@ class Loader {
       for (int c = 0; c < comps; ++c) {
         const unsigned char* q = p + c * size;
         switch (acc.componentType) {
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i * comps + c] = *q; break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            out[i * comps + c] = *q;
+            break;
           case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
             uint16_t v;
             std::memcpy(&v, q, 2);
@@ -143,15 +145,17 @@ class Loader {
       fail(fmt::format("{} (accessor {}) has an invalid type", what, index));
     const std::size_t elem = std::size_t(comps) * csize;
     const std::size_t stride = view.byteStride > 0 ? view.byteStride : elem;
-    const std::size_t need =
-        acc.count == 0 ? 0 : acc.byteOffset + stride * (acc.count - 1) + elem;
+    const std::size_t need = acc.count == 0 ? 0 : acc.byteOffset + stride * (acc.count - 1) + elem;
     if (need > view.byteLength)
-      fail(fmt::format("{} (accessor {}) is out of range: it needs {} bytes of buffer view {}, "
-                       "which has {}", what, index, need, acc.bufferView, view.byteLength));
+      fail(
+          fmt::format("{} (accessor {}) is out of range: it needs {} bytes of buffer view {}, "
+                      "which has {}",
+                      what, index, need, acc.bufferView, view.byteLength));
     if (view.byteOffset + view.byteLength > buffer.data.size())
-      fail(fmt::format("buffer view {} is out of range: it ends at byte {} of buffer {}, which "
-                       "has {}", acc.bufferView, view.byteOffset + view.byteLength, view.buffer,
-                       buffer.data.size()));
+      fail(fmt::format(
+          "buffer view {} is out of range: it ends at byte {} of buffer {}, which "
+          "has {}",
+          acc.bufferView, view.byteOffset + view.byteLength, view.buffer, buffer.data.size()));
     return {buffer.data.data() + view.byteOffset + acc.byteOffset, stride};
   }
 
@@ -258,9 +262,12 @@ class Loader {
     if (t.sampler >= 0 && t.sampler < int(m_.samplers.size())) {
       auto wrap = [](int mode) {
         switch (mode) {
-          case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return scene::Texture::Wrap::kClamp;
-          case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return scene::Texture::Wrap::kMirror;
-          default: return scene::Texture::Wrap::kRepeat;
+          case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+            return scene::Texture::Wrap::kClamp;
+          case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+            return scene::Texture::Wrap::kMirror;
+          default:
+            return scene::Texture::Wrap::kRepeat;
         }
       };
       out.wrap_s = wrap(m_.samplers[t.sampler].wrapS);
@@ -372,12 +379,13 @@ class Loader {
       out.name = skin.name;
       for (int j : skin.joints) {
         if (j < 0 || j >= int(m_.nodes.size()))
-          fail(fmt::format("skin {} refers to node {}, but the file has {}", si, j, m_.nodes.size()));
+          fail(fmt::format("skin {} refers to node {}, but the file has {}", si, j,
+                           m_.nodes.size()));
         out.joints.push_back(j);
       }
       if (skin.inverseBindMatrices >= 0) {
-        const std::vector<float> f =
-            read_floats(skin.inverseBindMatrices, 16, fmt::format("skin {} inverseBindMatrices", si));
+        const std::vector<float> f = read_floats(skin.inverseBindMatrices, 16,
+                                                 fmt::format("skin {} inverseBindMatrices", si));
         if (f.size() / 16 < out.joints.size())
           fail(fmt::format("skin {} has {} inverse bind matrices for {} joints", si, f.size() / 16,
                            out.joints.size()));
@@ -479,8 +487,8 @@ class Loader {
         smp.interpolation = in.interpolation == "STEP"          ? scene::Interpolation::kStep
                             : in.interpolation == "CUBICSPLINE" ? scene::Interpolation::kCubicSpline
                                                                 : scene::Interpolation::kLinear;
-        const std::size_t keys = smp.times.size() * (smp.interpolation ==
-                                                     scene::Interpolation::kCubicSpline ? 3 : 1);
+        const std::size_t keys =
+            smp.times.size() * (smp.interpolation == scene::Interpolation::kCubicSpline ? 3 : 1);
         if (smp.values.size() % keys != 0 || smp.values.empty())
           fail(fmt::format("{} output has {} values for {} keys", what, smp.values.size(), keys));
         smp.components = int(smp.values.size() / keys);
@@ -511,8 +519,8 @@ class Loader {
           fail(fmt::format("animation '{}' {} channel has {} components per key, expected {}",
                            out.name, ch.target_path, comps, need));
         if (s.nodes[c.node].has_matrix)
-          fail(fmt::format("animation '{}' animates node {}, which is given by a matrix",
-                           out.name, c.node));
+          fail(fmt::format("animation '{}' animates node {}, which is given by a matrix", out.name,
+                           c.node));
         out.channels.push_back(c);
       }
       if (out.samplers.empty()) out.start = out.end = 0.0f;
@@ -548,7 +556,8 @@ Scene load_gltf(const std::string& path) {
   tinygltf::Model model;
   std::string err, warn;
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   // Sniff the magic rather than trust the extension.
   bool binary = ext == ".glb";
   if (FILE* f = std::fopen(path.c_str(), "rb")) {

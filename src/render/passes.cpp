@@ -9,12 +9,18 @@ namespace emaki::render {
 
 const std::vector<PassInfo>& pass_table() {
   static const std::vector<PassInfo> table = {
-      {"normal", kNormal, 3, "XYZ"},          {"position", kPosition, 3, "XYZ"},
-      {"position_norm", kPositionNorm, 3, "XYZ"}, {"rest_position", kRestPosition, 3, "XYZ"},
-      {"depth", kDepth, 1, "Z"},              {"diffuse", kDiffuse, 1, "Y"},
-      {"shadow", kShadow, 1, "Y"},            {"albedo", kAlbedo, 3, "RGB"},
-      {"object_id", kObjectId, 1, "Y"},       {"material_id", kMaterialId, 1, "Y"},
-      {"outline", kOutline, 1, "Y"},          {"motion", kMotion, 2, "XY"},
+      {"normal", kNormal, 3, "XYZ"},
+      {"position", kPosition, 3, "XYZ"},
+      {"position_norm", kPositionNorm, 3, "XYZ"},
+      {"rest_position", kRestPosition, 3, "XYZ"},
+      {"depth", kDepth, 1, "Z"},
+      {"diffuse", kDiffuse, 1, "Y"},
+      {"shadow", kShadow, 1, "Y"},
+      {"albedo", kAlbedo, 3, "RGB"},
+      {"object_id", kObjectId, 1, "Y"},
+      {"material_id", kMaterialId, 1, "Y"},
+      {"outline", kOutline, 1, "Y"},
+      {"motion", kMotion, 2, "XY"},
       {"alpha", kAlpha, 1, "A"},
   };
   return table;
@@ -81,8 +87,9 @@ Image<float> preview(ImageView<const float> frame, const PassInfo& pass) {
           for (int c = 0; c < 3; ++c) o[c] = std::clamp(v[c], 0.0f, 1.0f);
           break;
         case kDepth:
-          o[0] = o[1] = o[2] =
-              a > 0 && hi > lo ? 1.0f - 0.9f * std::clamp((v[0] - lo) / (hi - lo), 0.0f, 1.0f) : 0.0f;
+          o[0] = o[1] = o[2] = a > 0 && hi > lo
+                                   ? 1.0f - 0.9f * std::clamp((v[0] - lo) / (hi - lo), 0.0f, 1.0f)
+                                   : 0.0f;
           break;
         case kAlbedo:
           for (int c = 0; c < 3; ++c) o[c] = encode_srgb(v[c]);

@@ -11,19 +11,19 @@ namespace emaki::render {
 
 // First channel of each pass in the interleaved frame image.
 enum Channel : int {
-  kNormal = 0,         // 3: camera space, x right, y up, z towards the viewer
-  kPosition = 3,       // 3: world space
-  kPositionNorm = 6,   // 3: world space mapped into the shot's fixed box -> [0, 1]
-  kRestPosition = 9,   // 3: rest-pose object space mapped into the scene's rest box -> [0, 1]
-  kDepth = 12,         // 1: view-space distance along the camera axis
-  kDiffuse = 13,       // 1: max(0, N.L) x light visibility
-  kShadow = 14,        // 1: cast-shadow mask of the key light
-  kAlbedo = 15,        // 3: linear base colour x texture
-  kObjectId = 18,      // 1: 0 background, 1 ground, 2.. scene objects
-  kMaterialId = 19,    // 1: 0 background, 1 ground, 2.. scene materials
-  kOutline = 20,       // 1: line coverage
-  kMotion = 21,        // 2: pixels from here to the same surface point in the previous frame
-  kAlpha = 23,         // 1: coverage
+  kNormal = 0,        // 3: camera space, x right, y up, z towards the viewer
+  kPosition = 3,      // 3: world space
+  kPositionNorm = 6,  // 3: world space mapped into the shot's fixed box -> [0, 1]
+  kRestPosition = 9,  // 3: rest-pose object space mapped into the scene's rest box -> [0, 1]
+  kDepth = 12,        // 1: view-space distance along the camera axis
+  kDiffuse = 13,      // 1: max(0, N.L) x light visibility
+  kShadow = 14,       // 1: cast-shadow mask of the key light
+  kAlbedo = 15,       // 3: linear base colour x texture
+  kObjectId = 18,     // 1: 0 background, 1 ground, 2.. scene objects
+  kMaterialId = 19,   // 1: 0 background, 1 ground, 2.. scene materials
+  kOutline = 20,      // 1: line coverage
+  kMotion = 21,       // 2: pixels from here to the same surface point in the previous frame
+  kAlpha = 23,        // 1: coverage
   kChannelCount = 24,
 };
 

@@ -34,12 +34,12 @@ constexpr float kGuard = 16.0f;
 
 // A clipped, projected triangle ready for scan conversion.
 struct ScreenTri {
-  int64_t x[3], y[3];       // snapped sample coordinates (fixed point)
+  int64_t x[3], y[3];  // snapped sample coordinates (fixed point)
   float key[3];
-  float inv_w[3];           // perspective weights
-  glm::vec3 bary[3];        // barycentrics of each vertex in the original triangle
-  int32_t source;           // original triangle index
-  int x0, y0, x1, y1;       // sample bounding box, inclusive
+  float inv_w[3];      // perspective weights
+  glm::vec3 bary[3];   // barycentrics of each vertex in the original triangle
+  int32_t source;      // original triangle index
+  int x0, y0, x1, y1;  // sample bounding box, inclusive
 };
 
 struct PolyVertex {
@@ -60,7 +60,8 @@ void clip_polygon(std::vector<PolyVertex>& poly, std::vector<PolyVertex>& scratc
     if ((da >= 0) != (db >= 0)) {
       // Interpolate from the lexicographically smaller end, so the two triangles sharing this
       // edge (which walk it in opposite directions) compute the very same point: no cracks.
-      const bool a_first = std::tie(a.c.x, a.c.y, a.c.z, a.c.w) < std::tie(b.c.x, b.c.y, b.c.z, b.c.w);
+      const bool a_first =
+          std::tie(a.c.x, a.c.y, a.c.z, a.c.w) < std::tie(b.c.x, b.c.y, b.c.z, b.c.w);
       const PolyVertex& p = a_first ? a : b;
       const PolyVertex& q = a_first ? b : a;
       const float dp = a_first ? da : db, dq = a_first ? db : da;
@@ -135,8 +136,8 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
     for (int k = 1; k + 1 < n; ++k) {
       ScreenTri st;
       const P* q[3] = {&pv[0], &pv[k], &pv[k + 1]};
-      const int64_t area = (q[1]->x - q[0]->x) * (q[2]->y - q[0]->y) -
-                           (q[1]->y - q[0]->y) * (q[2]->x - q[0]->x);
+      const int64_t area =
+          (q[1]->x - q[0]->x) * (q[2]->y - q[0]->y) - (q[1]->y - q[0]->y) * (q[2]->x - q[0]->x);
       if (area == 0) continue;
       if (area < 0) std::swap(q[1], q[2]);  // both faces are drawn; keep one winding
       int64_t minx = INT64_MAX, miny = INT64_MAX, maxx = INT64_MIN, maxy = INT64_MIN;
@@ -195,8 +196,8 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
           ey[e] = dx << kSubBits;
           e_row[e] = dx * (py0 - st.y[a]) - dy * (px0 - st.x[a]);
         }
-        const double inv_area =
-            1.0 / double((st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) - (st.y[1] - st.y[0]) * (st.x[2] - st.x[0]));
+        const double inv_area = 1.0 / double((st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) -
+                                             (st.y[1] - st.y[0]) * (st.x[2] - st.x[0]));
         for (int y = y0; y <= y1; ++y) {
           int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
           for (int x = x0; x <= x1; ++x) {
@@ -211,7 +212,8 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
                 if (attrs) {
                   const float q0 = l0 * st.inv_w[0], q1 = l1 * st.inv_w[1], q2 = l2 * st.inv_w[2];
                   const float s = 1.0f / (q0 + q1 + q2);
-                  const glm::vec3 bary = (q0 * s) * st.bary[0] + (q1 * s) * st.bary[1] + (q2 * s) * st.bary[2];
+                  const glm::vec3 bary =
+                      (q0 * s) * st.bary[0] + (q1 * s) * st.bary[1] + (q2 * s) * st.bary[2];
                   out.b1[idx] = bary.y;
                   out.b2[idx] = bary.z;
                 }

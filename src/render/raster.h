@@ -5,9 +5,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 namespace emaki::render {
 
@@ -31,8 +30,8 @@ struct VisibilityBuffer {
 
 struct RasterOptions {
   bool perspective = true;
-  float znear = 0.01f;           // triangles are clipped to depth >= znear
-  bool with_attributes = true;   // false: depth (key) only, e.g. a shadow map
+  float znear = 0.01f;          // triangles are clipped to depth >= znear
+  bool with_attributes = true;  // false: depth (key) only, e.g. a shadow map
 };
 
 // Draws triangles (3 vertex indices each) into `out`, whose size says the sample grid; NDC

@@ -1,5 +1,3 @@
-#include "render/renderer.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +12,7 @@
 #include "io/gltf_loader.h"
 #include "render/passes.h"
 #include "render/raster.h"
+#include "render/renderer.h"
 
 namespace emaki::render {
 namespace {
@@ -57,7 +56,8 @@ Agreement follow_motion(const Image<float>& cur, const Image<float>& prev, int f
       if (p[kAlpha] < 1.0f || p[kObjectId] < min_object || p[kOutline] > 0.0f) continue;
       ++a.candidates;
       glm::vec3 there;
-      if (!sample3(prev, x + 0.5f + p[kMotion], y + 0.5f + p[kMotion + 1], first, p[kObjectId], there))
+      if (!sample3(prev, x + 0.5f + p[kMotion], y + 0.5f + p[kMotion + 1], first, p[kObjectId],
+                   there))
         continue;
       errors.push_back(glm::length(there - glm::vec3(p[first], p[first + 1], p[first + 2])));
     }
@@ -87,15 +87,18 @@ TEST(Render, StaticObjectMovingCameraPositionsFollowMotion) {
   const ShotRenderer r(s, shot, options);
   const Image<float> prev = r.render(4), cur = r.render(5);
   const Agreement a = follow_motion(cur, prev, kPositionNorm, 1.0f);
-  std::printf("static object, moving camera: position_norm error mean %.5f, p95 %.5f (box units) "
-              "over %d of %d covered pixels\n", a.mean, a.p95, a.pixels, a.candidates);
+  std::printf(
+      "static object, moving camera: position_norm error mean %.5f, p95 %.5f (box units) "
+      "over %d of %d covered pixels\n",
+      a.mean, a.p95, a.pixels, a.candidates);
   ASSERT_GT(a.pixels, 0.5 * a.candidates);
   EXPECT_LT(a.mean, 0.005);
   EXPECT_LT(a.p95, 0.005);
   // The camera did move: the motion field is not zero.
   double motion = 0;
   for (int y = 0; y < cur.height(); ++y)
-    for (int x = 0; x < cur.width(); ++x) motion = std::max<double>(motion, std::abs(cur(x, y, kMotion)));
+    for (int x = 0; x < cur.width(); ++x)
+      motion = std::max<double>(motion, std::abs(cur(x, y, kMotion)));
   EXPECT_GT(motion, 2.0);
 }
 
@@ -113,9 +116,10 @@ TEST(Render, FoxWalkRestPositionFollowsMotion) {
   const Image<float> prev = r.render(7), cur = r.render(8);
   const Agreement rest = follow_motion(cur, prev, kRestPosition, 2.0f);
   const Agreement pos = follow_motion(cur, prev, kPositionNorm, 2.0f);
-  std::printf("Fox Walk frame 8 -> 7: rest_position error mean %.5f p95 %.5f; position_norm error "
-              "mean %.5f p95 %.5f (box units) over %d of %d fox pixels\n",
-              rest.mean, rest.p95, pos.mean, pos.p95, rest.pixels, rest.candidates);
+  std::printf(
+      "Fox Walk frame 8 -> 7: rest_position error mean %.5f p95 %.5f; position_norm error "
+      "mean %.5f p95 %.5f (box units) over %d of %d fox pixels\n",
+      rest.mean, rest.p95, pos.mean, pos.p95, rest.pixels, rest.candidates);
   ASSERT_GT(rest.pixels, 0.5 * rest.candidates);
   EXPECT_LT(rest.mean, 0.005);
   EXPECT_LT(rest.p95, 0.005);

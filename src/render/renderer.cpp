@@ -1,11 +1,11 @@
 #include "render/renderer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-#include <limits>
-
-#include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -123,7 +123,8 @@ FrameGeometry build_geometry(const scene::Scene& scene, const scene::PosedScene&
   g.caster_indices = g.indices.size();
   if (ground.enabled) {
     const glm::vec3 c = shot_bounds.empty() ? glm::vec3(0.0f) : shot_bounds.center();
-    const float extent = shot_bounds.empty() ? 1.0f : std::max(shot_bounds.size().x, shot_bounds.size().z);
+    const float extent =
+        shot_bounds.empty() ? 1.0f : std::max(shot_bounds.size().x, shot_bounds.size().z);
     const float half = 0.5f * (ground.size > 0.0f ? ground.size : 6.0f * std::max(extent, 1e-3f));
     const uint32_t base = uint32_t(g.pos.size());
     const glm::vec3 corners[4] = {{c.x - half, ground_height, c.z - half},
@@ -151,12 +152,14 @@ FrameGeometry build_geometry(const scene::Scene& scene, const scene::PosedScene&
 
 float wrap_coord(float u, scene::Texture::Wrap mode) {
   switch (mode) {
-    case scene::Texture::Wrap::kClamp: return std::clamp(u, 0.0f, 1.0f);
+    case scene::Texture::Wrap::kClamp:
+      return std::clamp(u, 0.0f, 1.0f);
     case scene::Texture::Wrap::kMirror: {
       const float f = u - 2.0f * std::floor(0.5f * u);
       return f > 1.0f ? 2.0f - f : f;
     }
-    default: return u - std::floor(u);
+    default:
+      return u - std::floor(u);
   }
 }
 
@@ -278,9 +281,11 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
   for (std::size_t t = 0; t < g.tris.size(); ++t) {
     const glm::vec3 p0 = glm::vec3(proj.cam.view * glm::vec4(g.pos[g.indices[3 * t]], 1.0f));
     const glm::vec3 n = rot * g.tris[t].face_normal;
-    tris[t] = {g.tris[t].object_id, g.tris[t].material_id, n, glm::dot(n, p0), g.tris[t].face_normal};
+    tris[t] = {g.tris[t].object_id, g.tris[t].material_id, n, glm::dot(n, p0),
+               g.tris[t].face_normal};
   }
-  const float cos_crease = std::cos(std::clamp(opt.crease_deg, 0.0f, 180.0f) * 3.14159265f / 180.0f);
+  const float cos_crease =
+      std::cos(std::clamp(opt.crease_deg, 0.0f, 180.0f) * 3.14159265f / 180.0f);
   const float jump = opt.depth_jump;
   // Relative error of predicting sample b's depth from the plane of sample a's triangle.
   auto plane_error = [&](const OutlineTri& ta, int bx, int by, float depth_b) {
@@ -333,7 +338,8 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
       float d = far;
       for (int x = 0; x < W; ++x) row[x] = d = marked[x] ? 0.0f : std::min(far, d + 1.0f);
       d = far;
-      for (int x = W - 1; x >= 0; --x) row[x] = std::min(row[x], d = marked[x] ? 0.0f : std::min(far, d + 1.0f));
+      for (int x = W - 1; x >= 0; --x)
+        row[x] = std::min(row[x], d = marked[x] ? 0.0f : std::min(far, d + 1.0f));
     }
   });
   // Vertical combination gives the exact Euclidean distance within `reach`; a sample's coverage
@@ -383,8 +389,8 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
     animation_ = 0;
   }
   if (shot_.first_frame < 0 || shot_.last_frame < shot_.first_frame)
-    throw Error("--frames", fmt::format("invalid frame range {}-{}", shot_.first_frame,
-                                        shot_.last_frame));
+    throw Error("--frames",
+                fmt::format("invalid frame range {}-{}", shot_.first_frame, shot_.last_frame));
   if (animation_ >= 0) {
     const scene::Animation& a = scene.animations[animation_];
     const float duration = a.end - a.start;
@@ -407,8 +413,8 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
     if (f == shot_.first_frame) rest_box_ = cube_around(scene::rest_bounds(posed));
   }
   position_box_ = cube_around(shot_bounds_);
-  ground_height_ = shot_.ground.auto_height && !shot_bounds_.empty() ? shot_bounds_.lo.y
-                                                                     : shot_.ground.height;
+  ground_height_ =
+      shot_.ground.auto_height && !shot_bounds_.empty() ? shot_bounds_.lo.y : shot_.ground.height;
   light_ = scene::light_direction(shot_, camera(float(shot_.first_frame)));
 }
 

@@ -14,13 +14,13 @@
 namespace emaki::render {
 
 struct RenderOptions {
-  int width = 640;               // pixels, [1, 16384]
-  int height = 360;              // pixels, [1, 16384]
-  int aa = 2;                    // samples per pixel side (aa x aa per pixel), [1, 4]
-  float outline_width = 1.5f;    // line width in pixels, [0, 16]; 0 = no lines
-  float crease_deg = 45.0f;      // angle between face normals drawn as a crease, [0, 180]
-  float depth_jump = 0.03f;      // relative depth gap drawn as a silhouette line, (0, 1]
-  int shadow_map_size = 2048;    // texels per side, [64, 8192]
+  int width = 640;             // pixels, [1, 16384]
+  int height = 360;            // pixels, [1, 16384]
+  int aa = 2;                  // samples per pixel side (aa x aa per pixel), [1, 4]
+  float outline_width = 1.5f;  // line width in pixels, [0, 16]; 0 = no lines
+  float crease_deg = 45.0f;    // angle between face normals drawn as a crease, [0, 180]
+  float depth_jump = 0.03f;    // relative depth gap drawn as a silhouette line, (0, 1]
+  int shadow_map_size = 2048;  // texels per side, [64, 8192]
 };
 
 // Renders the frames of one shot. Everything fixed for the shot (the clip, the normalisation
@@ -30,7 +30,8 @@ class ShotRenderer {
  public:
   // Throws emaki::Error for a clip that is not in the scene ("--clip") or a frame range that
   // leaves the clip ("--frames").
-  ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& shot, const RenderOptions& options);
+  ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& shot,
+               const RenderOptions& options);
 
   // The kChannelCount-channel frame (see passes.h).
   Image<float> render(int frame) const;
@@ -48,9 +49,9 @@ class ShotRenderer {
   scene::ShotSpec shot_;
   RenderOptions options_;
   int animation_ = -1;
-  scene::Bounds shot_bounds_;    // world bounds of the objects over the frame range
-  scene::Bounds position_box_;   // cube around shot_bounds_
-  scene::Bounds rest_box_;       // cube around the rest-pose bounds
+  scene::Bounds shot_bounds_;   // world bounds of the objects over the frame range
+  scene::Bounds position_box_;  // cube around shot_bounds_
+  scene::Bounds rest_box_;      // cube around the rest-pose bounds
   float ground_height_ = 0.0f;
   glm::vec3 light_{0, 1, 0};
 };

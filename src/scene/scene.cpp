@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/check.h"
@@ -19,7 +18,9 @@ int Scene::find_animation(const std::string& name) const {
 // Keyframe sampling
 
 namespace {
-glm::quat quat_from(const float* xyzw) { return glm::quat(xyzw[3], xyzw[0], xyzw[1], xyzw[2]); }
+glm::quat quat_from(const float* xyzw) {
+  return glm::quat(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+}
 void store(const glm::quat& q, float* xyzw) {
   xyzw[0] = q.x, xyzw[1] = q.y, xyzw[2] = q.z, xyzw[3] = q.w;
 }
@@ -62,9 +63,9 @@ void sample(const AnimSampler& s, float t, bool is_rotation, float* out) {
     case Interpolation::kCubicSpline: {
       // glTF 2.0 Appendix C: Hermite spline with tangents scaled by the key interval.
       const float* v0 = key(i);
-      const float* b0 = v0 + c;                 // out-tangent of key i
+      const float* b0 = v0 + c;  // out-tangent of key i
       const float* v1 = key(i + 1);
-      const float* a1 = v1 - c;                 // in-tangent of key i+1
+      const float* a1 = v1 - c;  // in-tangent of key i+1
       const float u2 = u * u, u3 = u2 * u;
       const float h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u;
       const float h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
@@ -133,8 +134,8 @@ Pose evaluate_pose(const Scene& scene, int animation, float t) {
     if (node.has_matrix) {
       local = node.matrix;
     } else {
-      local = glm::translate(glm::mat4(1.0f), pose.translation[i]) * glm::mat4_cast(pose.rotation[i]) *
-              glm::scale(glm::mat4(1.0f), pose.scale[i]);
+      local = glm::translate(glm::mat4(1.0f), pose.translation[i]) *
+              glm::mat4_cast(pose.rotation[i]) * glm::scale(glm::mat4(1.0f), pose.scale[i]);
     }
     pose.world[i] = node.parent >= 0 ? pose.world[node.parent] * local : local;
     for (int c : node.children) stack.push_back(c);
@@ -179,8 +180,10 @@ void pose_primitive(const Scene& scene, const Pose& pose, int node_index, const 
     const float w = morph_weights[k];
     if (w == 0.0f) continue;
     const MorphTarget& target = prim.targets[k];
-    for (std::size_t v = 0; v < target.positions.size() && v < nv; ++v) pos[v] += w * target.positions[v];
-    for (std::size_t v = 0; v < target.normals.size() && v < nrm.size(); ++v) nrm[v] += w * target.normals[v];
+    for (std::size_t v = 0; v < target.positions.size() && v < nv; ++v)
+      pos[v] += w * target.positions[v];
+    for (std::size_t v = 0; v < target.normals.size() && v < nrm.size(); ++v)
+      nrm[v] += w * target.normals[v];
   }
   const bool has_normals = nrm.size() == nv;
   out.world_positions.resize(nv);

@@ -4,11 +4,10 @@
 #pragma once
 
 #include <cstdint>
-#include <string>
-#include <vector>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <string>
+#include <vector>
 
 #include "core/image.h"
 
@@ -24,7 +23,7 @@ struct Texture {
 
 struct Material {
   std::string name;
-  glm::vec4 base_color{1.0f};  // linear RGBA factor
+  glm::vec4 base_color{1.0f};   // linear RGBA factor
   int base_color_texture = -1;  // index into Scene::textures, -1: none
   int texcoord = 0;             // which UV set the texture reads (only set 0 is kept)
 };
@@ -55,14 +54,14 @@ struct Mesh {
 
 struct Skin {
   std::string name;
-  std::vector<int> joints;  // node indices
+  std::vector<int> joints;              // node indices
   std::vector<glm::mat4> inverse_bind;  // one per joint
 };
 
 struct CameraDef {
   std::string name;
   bool perspective = true;
-  float yfov = 0.8f;  // radians (perspective)
+  float yfov = 0.8f;               // radians (perspective)
   float xmag = 1.0f, ymag = 1.0f;  // half extents (orthographic)
   float znear = 0.01f;
 };
@@ -146,9 +145,9 @@ struct PosedPrimitive {
   int object_id = 0;
   int material = -1;
   std::vector<glm::vec3> world_positions;
-  std::vector<glm::vec3> world_normals;  // unit length
+  std::vector<glm::vec3> world_normals;                    // unit length
   const std::vector<glm::vec3>* rest_positions = nullptr;  // object space, bind pose
-  const std::vector<glm::vec2>* uvs = nullptr;              // may be empty
+  const std::vector<glm::vec2>* uvs = nullptr;             // may be empty
   const std::vector<uint32_t>* indices = nullptr;
 };
 

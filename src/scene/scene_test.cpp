@@ -3,9 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <string>
-
 #include <glm/gtc/matrix_transform.hpp>
+#include <string>
 
 #include "io/gltf_loader.h"
 #include "scene/shot.h"
@@ -52,9 +51,10 @@ TEST(SimpleSkin, JointAndVertexPosesFollowTheClip) {
     expect_near(p[8], v8, 2e-3f);
     expect_near(p[0], {-0.5f, 0.0f, 0.0f});
     // Vertex 4 is (0, 1, 0) weighted half and half.
-    const glm::vec3 v4 = 0.5f * glm::vec3(-0.5f, 1.0f, 0.0f) +
-                         0.5f * (glm::vec3(0, 1, 0) + glm::vec3(glm::rotate(glm::mat4(1.0f), theta, {0, 0, 1}) *
-                                                                glm::vec4(-0.5f, 0.0f, 0.0f, 1.0f)));
+    const glm::vec3 v4 =
+        0.5f * glm::vec3(-0.5f, 1.0f, 0.0f) +
+        0.5f * (glm::vec3(0, 1, 0) + glm::vec3(glm::rotate(glm::mat4(1.0f), theta, {0, 0, 1}) *
+                                               glm::vec4(-0.5f, 0.0f, 0.0f, 1.0f)));
     expect_near(p[4], v4, 2e-3f);
   }
 }
@@ -68,8 +68,9 @@ TEST(BoxAnimated, NodesFollowTheClip) {
   struct Case {
     float t, y, angle_deg;
   };
-  for (const Case c : {Case{0.0f, 0.0f, 0.0f}, Case{0.625f, 1.26f, 0.0f}, Case{1.875f, 2.52f, 90.0f},
-                       Case{2.5f, 2.52f, 180.0f}, Case{3.1041650f, 1.26f, 180.0f}}) {
+  for (const Case c :
+       {Case{0.0f, 0.0f, 0.0f}, Case{0.625f, 1.26f, 0.0f}, Case{1.875f, 2.52f, 90.0f},
+        Case{2.5f, 2.52f, 180.0f}, Case{3.1041650f, 1.26f, 180.0f}}) {
     const Pose pose = evaluate_pose(s, 0, c.t);
     expect_near(glm::vec3(pose.world[0][3]), {0.0f, c.y, 0.0f}, 1e-3f);
     // The box's world rotation angle about X (its direction is a sign convention of slerp on

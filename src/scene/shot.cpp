@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace emaki::scene {
 
-glm::vec3 ViewCamera::position() const { return glm::vec3(glm::inverse(view)[3]); }
+glm::vec3 ViewCamera::position() const {
+  return glm::vec3(glm::inverse(view)[3]);
+}
 
 namespace {
 constexpr float kDeg = 3.14159265358979f / 180.0f;
@@ -44,7 +45,8 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
     return cam;
   }
 
-  glm::vec3 target = spec.has_target || spec.mode == CameraSpec::Mode::kLookAt ? spec.target : center;
+  glm::vec3 target =
+      spec.has_target || spec.mode == CameraSpec::Mode::kLookAt ? spec.target : center;
   glm::vec3 eye;
   const float half_fov = 0.5f * std::clamp(spec.fov_deg, 0.1f, 170.0f) * kDeg;
   cam.tan_half_fov = std::tan(half_fov);
@@ -84,7 +86,8 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
   }
 
   const float span = float(std::max(1, shot.last_frame - shot.first_frame));
-  const float u = shot.last_frame > shot.first_frame ? (frame - float(shot.first_frame)) / span : 0.0f;
+  const float u =
+      shot.last_frame > shot.first_frame ? (frame - float(shot.first_frame)) / span : 0.0f;
   glm::vec3 offset = eye - target;
   if (spec.orbit_deg != 0.0f) {
     const float a = spec.orbit_deg * kDeg * u;
@@ -108,7 +111,8 @@ glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera) 
   glm::vec3 d = shot.light.direction;
   if (glm::length(d) < 1e-12f) d = glm::vec3(0, 1, 0);
   d = glm::normalize(d);
-  if (shot.light.camera_relative) d = glm::normalize(glm::transpose(glm::mat3(first_camera.view)) * d);
+  if (shot.light.camera_relative)
+    d = glm::normalize(glm::transpose(glm::mat3(first_camera.view)) * d);
   return d;
 }
 

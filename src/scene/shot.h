@@ -3,9 +3,8 @@
 // range. Filled by the CLI now and by the shot file later; resolved per frame into a ViewCamera.
 #pragma once
 
-#include <string>
-
 #include <glm/glm.hpp>
+#include <string>
 
 #include "scene/scene.h"
 
@@ -20,11 +19,11 @@ struct CameraSpec {
   Mode mode = Mode::kAuto;
   glm::vec3 position{0.0f, 0.0f, 5.0f};
   glm::vec3 target{0.0f};
-  bool has_target = false;   // kAuto: aim at `target` instead of the bounds' centre
-  float azimuth_deg = 30.0f;   // kAuto: around +Y, 0 = looking from +Z (glTF front)
-  float elevation_deg = 15.0f; // kAuto: above the horizon
-  float distance = 0.0f;     // kAuto: 0 = fit the bounds
-  float fov_deg = 40.0f;     // vertical field of view, (0, 170)
+  bool has_target = false;      // kAuto: aim at `target` instead of the bounds' centre
+  float azimuth_deg = 30.0f;    // kAuto: around +Y, 0 = looking from +Z (glTF front)
+  float elevation_deg = 15.0f;  // kAuto: above the horizon
+  float distance = 0.0f;        // kAuto: 0 = fit the bounds
+  float fov_deg = 40.0f;        // vertical field of view, (0, 170)
   bool orthographic = false;
   float ortho_height = 0.0f;  // full visible height in scene units; 0 = fit (kAuto)
   int gltf_node = -1;
@@ -47,10 +46,10 @@ struct LightSpec {
 
 struct GroundSpec {
   bool enabled = true;
-  float size = 0.0f;    // side of the square; 0 = 6x the shot's bounds
-  float height = 0.0f;  // y of the plane
+  float size = 0.0f;        // side of the square; 0 = 6x the shot's bounds
+  float height = 0.0f;      // y of the plane
   bool auto_height = true;  // put it under the lowest point of the shot
-  glm::vec3 color{0.8f};  // linear albedo
+  glm::vec3 color{0.8f};    // linear albedo
 };
 
 struct ShotSpec {
