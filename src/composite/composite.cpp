@@ -130,7 +130,10 @@ Image<float> color_layer(const LayerInput& layer, int width, int height) {
   if (look.source == ColorSource::kGradient && look.gradient.empty())
     throw Error(fmt::format("layers.{}.gradient", layer.name), "needs at least one stop");
   const Filters& f = look.filters;
-  const bool has_mask = layer.value.channels >= 2;
+  const int n = layer.value_channels;
+  CHECK(n == 1 || n == 3);
+  CHECK_GE(layer.value.channels, n);
+  const bool has_mask = layer.value.channels > n;
   Image<float> out(width, height, 4);
   parallel_rows(height, 16, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
@@ -139,7 +142,10 @@ Image<float> color_layer(const LayerInput& layer, int width, int height) {
         const float mask = has_mask ? clamp01(p[layer.value.channels - 1]) : 1.0f;
         const float v = apply_levels(clamp01(p[0]), f);
         Color c;
-        switch (look.source) {
+        if (n == 3) {
+          c = {apply_levels(clamp01(p[0]), f), apply_levels(clamp01(p[1]), f),
+               apply_levels(clamp01(p[2]), f)};
+        } else switch (look.source) {
           case ColorSource::kAlbedo: {
             const float* a = layer.albedo.at(x, y);
             c = {srgb_encode(a[0]) * v, srgb_encode(a[1]) * v, srgb_encode(a[2]) * v};
@@ -150,9 +156,11 @@ Image<float> color_layer(const LayerInput& layer, int width, int height) {
         }
         c = {c.r * f.tint.r, c.g * f.tint.g, c.b * f.tint.b};
         c = hue_saturation(c, f.hue_deg, f.saturation);
+        // A colour layer's value, for coverage, is its luma.
+        const float cov = n == 3 ? 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b : v;
         float alpha = mask;
-        if (look.alpha_from == AlphaFrom::kValue) alpha *= v;
-        if (look.alpha_from == AlphaFrom::kInverseValue) alpha *= 1.0f - v;
+        if (look.alpha_from == AlphaFrom::kValue) alpha *= cov;
+        if (look.alpha_from == AlphaFrom::kInverseValue) alpha *= 1.0f - cov;
         float* o = out.at(x, y);
         o[0] = clamp01(c.r);
         o[1] = clamp01(c.g);

@@ -62,13 +62,16 @@ struct LayerLook {
   BlendMode blend = BlendMode::kNormal;
 };
 
-// One layer to composite. `value`: the layer's value in its first channel and, if it has two or
-// more channels, the mask coverage in its last one (a synthesis output with a target mask).
+// One layer to composite. `value`: the layer's value in its first `value_channels` channels and,
+// if it has one more, the mask coverage in its last one (a synthesis output with a target mask).
+// A 3-channel (not single-colour) layer brings its own colours: its look's colour source is
+// ignored and the levels apply to each channel.
 struct LayerInput {
   std::string name;
   ImageView<const float> value;
   ImageView<const float> albedo;  // linear RGB, the output size; needed for ColorSource::kAlbedo
   LayerLook look;
+  int value_channels = 1;  // 1 or 3
 };
 
 // The paper under every layer: a texture tiled from the top-left corner, or a flat colour.

@@ -162,3 +162,17 @@ TEST(Composite, MismatchedLayerSizeIsAnError) {
 
 }  // namespace
 }  // namespace emaki::composite
+
+namespace emaki::composite {
+namespace {
+TEST(Composite, ColourLayerBringsItsOwnColours) {
+  const Image<float> value = constant(1, 1, {0.2f, 0.4f, 0.6f, 0.5f});  // RGB + mask
+  LayerInput layer{"paint", value.cview(), {}, {}, 3};
+  layer.look.flat = {0, 0, 0};  // ignored
+  const Image<float> c = color_layer(layer, 1, 1);
+  EXPECT_FLOAT_EQ(c(0, 0, 0), 0.2f);
+  EXPECT_FLOAT_EQ(c(0, 0, 2), 0.6f);
+  EXPECT_FLOAT_EQ(c(0, 0, 3), 0.5f);
+}
+}  // namespace
+}  // namespace emaki::composite

@@ -1,0 +1,357 @@
+#include "io/shot_inputs.h"
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "io/gltf_loader.h"
+#include "io/image_io.h"
+
+extern char** environ;
+
+namespace emaki::io {
+
+namespace fs = std::filesystem;
+using pipeline::Shot;
+
+std::string frame_file(const std::string& pattern, int frame) {
+  std::string out;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') {
+      out += pattern[i];
+      continue;
+    }
+    std::size_t j = i + 1;
+    int width = 0;
+    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j])))
+      width = width * 10 + (pattern[j++] - '0');
+    out += fmt::format("{:0{}d}", frame, width);
+    i = j;  // at the 'd'
+  }
+  return out;
+}
+
+std::vector<std::string> source_channels(const pipeline::Source& source, const render::PassInfo& pass) {
+  for (const auto& m : source.channels)
+    if (m.pass == pass.name) return m.channels;
+  std::vector<std::string> names;
+  for (int c = 0; c < pass.count; ++c) names.push_back(fmt::format("{}.{}", pass.name, pass.suffixes[c]));
+  return names;
+}
+
+namespace {
+
+// Errors from the renderer name its command-line options; here they are shot file keys.
+[[noreturn]] void rethrow_as_key(const Error& e, const std::string& key) {
+  std::string message = e.what();
+  if (!e.subject().empty() && message.rfind(e.subject() + ": ", 0) == 0)
+    message = message.substr(e.subject().size() + 2);
+  throw Error(key, message);
+}
+
+class SequenceFrames : public pipeline::FrameSource {
+ public:
+  explicit SequenceFrames(const pipeline::Source& s) : source_(s) {
+    for (const render::PassInfo& p : render::pass_table())
+      for (const std::string& c : source_channels(s, p)) channels_.push_back(c);
+  }
+  Image<float> passes(int frame) const override {
+    const std::string file = frame_file(source_.pattern, frame);
+    Image<float> img = read_image_float(file, ReadOptions{channels_});
+    if (img.width() != source_.width || img.height() != source_.height)
+      throw Error(file, fmt::format("is {}x{}, the sequence's first frame is {}x{}", img.width(),
+                                    img.height(), source_.width, source_.height));
+    return img;
+  }
+
+ private:
+  pipeline::Source source_;
+  std::vector<std::string> channels_;
+};
+
+Image<float> rgb_of(const std::string& key, const std::string& path) {
+  Image<float> img = read_image_float(path);
+  if (img.channels() >= 3 && img.channels() <= 4) {
+    if (img.channels() == 3) return img;
+    Image<float> out(img.width(), img.height(), 3);
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x)
+        for (int c = 0; c < 3; ++c) out(x, y, c) = img(x, y, c);
+    return out;
+  }
+  if (img.channels() <= 2) {
+    Image<float> out(img.width(), img.height(), 3);
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x)
+        for (int c = 0; c < 3; ++c) out(x, y, c) = img(x, y, 0);
+    return out;
+  }
+  throw Error(key, fmt::format("'{}' has {} channels; expected grey, RGB or RGBA", path, img.channels()));
+}
+
+}  // namespace
+
+std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
+  const pipeline::Source& s = shot.source;
+  if (s.kind == pipeline::SourceKind::kSequence) return std::make_unique<SequenceFrames>(s);
+  scene::Scene scene = load_gltf(s.scene_path);
+  try {
+    return pipeline::scene_frames(std::move(scene), s);
+  } catch (const Error& e) {
+    rethrow_as_key(e, e.subject() == "--clip" ? "source.clip" : "source.frames");
+  }
+}
+
+std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot) {
+  std::map<std::string, pipeline::ExemplarImages> out;
+  for (const pipeline::Exemplar& e : shot.exemplars) {
+    const std::string key = "exemplars." + e.name;
+    pipeline::ExemplarImages im;
+    im.painting = rgb_of(key + ".painting", e.painting);
+    const int w = im.painting.width(), h = im.painting.height();
+    if (e.kind == pipeline::ExemplarKind::kMatcap) {
+      try {
+        im.passes = pipeline::matcap_passes(e, w, h);
+      } catch (const Error& err) {
+        rethrow_as_key(err, key + (err.subject() == "--horizon" ? ".horizon" : ".sphere"));
+      }
+    } else {
+      // Read the passes the layers use as guides; the rest stay zero.
+      im.passes = Image<float>(w, h, render::kChannelCount);
+      const std::vector<std::string> have = list_channels(e.passes);
+      for (const pipeline::Layer& l : shot.layers) {
+        if (l.exemplar != e.name) continue;
+        for (const pipeline::GuideSpec& g : l.guides) {
+          const render::PassInfo* p = render::find_pass(g.pass);
+          std::vector<std::string> names;
+          for (int c = 0; c < p->count; ++c) names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
+          for (const std::string& n : names)
+            if (std::find(have.begin(), have.end(), n) == have.end())
+              throw Error(key + ".passes",
+                          fmt::format("channel '{}' (guide '{}' of layer '{}') is not in '{}'", n,
+                                      g.pass, l.name, e.passes));
+          const Image<float> pass = read_image_float(e.passes, ReadOptions{names});
+          if (pass.width() != w || pass.height() != h)
+            throw Error(key + ".passes", fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}",
+                                                     e.passes, pass.width(), pass.height(),
+                                                     e.painting, w, h));
+          for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+              for (int c = 0; c < p->count; ++c) im.passes(x, y, p->first + c) = pass(x, y, c);
+        }
+      }
+    }
+    out.emplace(e.name, std::move(im));
+  }
+  return out;
+}
+
+pipeline::CompositeInputs load_composite_inputs(const Shot& shot) {
+  pipeline::CompositeInputs ci;
+  if (!shot.compositing.paper.empty()) ci.paper = rgb_of("compositing.paper", shot.compositing.paper);
+  return ci;
+}
+
+// ---- the output folder ----
+
+std::string OutputPaths::layer_exr(const std::string& layer, int frame) const {
+  return fmt::format("{}/layers/{}/{}_{:04d}.exr", folder, layer, layer, frame);
+}
+std::string OutputPaths::layer_png(const std::string& layer, int frame) const {
+  return fmt::format("{}/layers/{}/{}_{:04d}.png", folder, layer, layer, frame);
+}
+std::string OutputPaths::composite_png(int frame) const {
+  return fmt::format("{}/composite/frame_{:04d}.png", folder, frame);
+}
+std::string OutputPaths::composite_exr(int frame) const {
+  return fmt::format("{}/composite/frame_{:04d}.exr", folder, frame);
+}
+std::string OutputPaths::layered_exr(int frame) const {
+  return fmt::format("{}/layered/frame_{:04d}.exr", folder, frame);
+}
+std::string OutputPaths::mp4() const { return folder + "/preview.mp4"; }
+std::string OutputPaths::contact_sheet() const { return folder + "/contact_sheet.png"; }
+
+namespace {
+
+void make_folder(const fs::path& p) {
+  std::error_code ec;
+  fs::create_directories(p, ec);
+  if (!fs::is_directory(p, ec)) throw Error("outputs.folder", fmt::format("cannot create folder '{}'", p.string()));
+}
+
+// image_io writes ".<stem>.tmp<pid><ext>" and renames it; a killed run leaves those behind.
+void remove_temporaries(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() > 1 && name[0] == '.' && name.find(".tmp") != std::string::npos &&
+        entry.is_regular_file(ec))
+      fs::remove(entry.path(), ec);
+  }
+}
+
+std::vector<std::string> value_names(const std::string& prefix, int channels, int value_channels) {
+  std::vector<std::string> n;
+  if (value_channels == 1) n.push_back(prefix + "Y");
+  else for (const char* c : {"R", "G", "B"}) n.push_back(prefix + c);
+  if (channels > value_channels) n.push_back(prefix + "A");
+  return n;
+}
+
+}  // namespace
+
+FileStore::FileStore(const Shot& shot) : shot_(shot) {
+  paths_.folder = shot.outputs.folder;
+  const fs::path root(paths_.folder);
+  std::vector<fs::path> dirs = {root, root / "composite", root / "layered"};
+  for (const pipeline::Layer& l : shot.layers) dirs.push_back(root / "layers" / l.name);
+  for (const fs::path& d : dirs) {
+    make_folder(d);
+    remove_temporaries(d);
+  }
+}
+
+bool FileStore::has_layer(const pipeline::Layer& layer, int frame) const {
+  std::error_code ec;
+  if (!fs::is_regular_file(paths_.layer_exr(layer.name, frame), ec)) return false;
+  return !shot_.outputs.layer_png || fs::is_regular_file(paths_.layer_png(layer.name, frame), ec);
+}
+
+Image<float> FileStore::read_layer(const pipeline::Layer& layer, int frame) const {
+  return read_image_float(paths_.layer_exr(layer.name, frame));
+}
+
+void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) {
+  const int n = layer.single_colour ? 1 : 3;
+  // The PNG first: the EXR is what marks the frame finished, so it is written last.
+  if (shot_.outputs.layer_png) {
+    WriteOptions png;
+    png.format = SampleFormat::kU16;
+    write_image(paths_.layer_png(layer.name, frame), value, png);
+  }
+  WriteOptions exr;
+  exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
+  exr.channel_names = value_names("", value.channels, n);
+  write_image(paths_.layer_exr(layer.name, frame), value, exr);
+}
+
+bool FileStore::has_frame(int frame) const {
+  std::error_code ec;
+  const pipeline::Outputs& o = shot_.outputs;
+  if (o.composite_png && !fs::is_regular_file(paths_.composite_png(frame), ec)) return false;
+  if (o.composite_exr && !fs::is_regular_file(paths_.composite_exr(frame), ec)) return false;
+  if (o.layered_exr && !fs::is_regular_file(paths_.layered_exr(frame), ec)) return false;
+  return true;
+}
+
+void FileStore::write_frame(int frame, ImageView<const float> composite,
+                            const std::vector<ImageView<const float>>& layers,
+                            ImageView<const float> passes) {
+  const pipeline::Outputs& o = shot_.outputs;
+  // The composite without its (constant) alpha.
+  Image<float> rgb(composite.width, composite.height, 3);
+  for (int y = 0; y < composite.height; ++y)
+    for (int x = 0; x < composite.width; ++x)
+      for (int c = 0; c < 3; ++c) rgb(x, y, c) = composite(x, y, c);
+  if (o.layered_exr) {
+    std::vector<std::string> names = render::channel_names();
+    int channels = passes.channels + 3;
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+      const auto n = value_names(shot_.layers[i].name + ".", layers[i].channels,
+                                 shot_.layers[i].single_colour ? 1 : 3);
+      names.insert(names.end(), n.begin(), n.end());
+      channels += layers[i].channels;
+    }
+    for (const char* c : {"composite.R", "composite.G", "composite.B"}) names.push_back(c);
+    Image<float> all(passes.width, passes.height, channels);
+    for (int y = 0; y < passes.height; ++y)
+      for (int x = 0; x < passes.width; ++x) {
+        float* d = all.at(x, y);
+        for (int c = 0; c < passes.channels; ++c) *d++ = passes(x, y, c);
+        for (const auto& l : layers)
+          for (int c = 0; c < l.channels; ++c) *d++ = l(x, y, c);
+        for (int c = 0; c < 3; ++c) *d++ = rgb(x, y, c);
+      }
+    WriteOptions wo;
+    wo.format = SampleFormat::kHalf;
+    wo.channel_names = names;
+    write_image(paths_.layered_exr(frame), all.cview(), wo);
+  }
+  if (o.composite_exr) {
+    WriteOptions wo;
+    wo.format = SampleFormat::kHalf;
+    write_image(paths_.composite_exr(frame), rgb.cview(), wo);
+  }
+  // The PNG last: with the default outputs it is what has_frame looks for first.
+  if (o.composite_png) {
+    WriteOptions wo;
+    wo.format = SampleFormat::kU16;
+    write_image(paths_.composite_png(frame), rgb.cview(), wo);
+  }
+}
+
+// ---- previews ----
+
+void encode_mp4(const std::string& pattern, int first, float fps, int crf, const std::string& out) {
+  const fs::path target(out);
+  const std::string tmp = (target.parent_path() / fmt::format(".{}.tmp{}.mp4", target.stem().string(), ::getpid())).string();
+  std::vector<std::string> args = {"ffmpeg", "-nostdin", "-y", "-loglevel", "error",
+                                   "-framerate", fmt::format("{}", fps), "-start_number",
+                                   std::to_string(first), "-i", pattern, "-c:v", "libx264",
+                                   "-pix_fmt", "yuv420p", "-crf", std::to_string(crf),
+                                   // yuv420p needs even sizes.
+                                   "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", tmp};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, "ffmpeg", nullptr, nullptr, argv.data(), environ) != 0)
+    throw Error("outputs.mp4", "cannot run 'ffmpeg' (is it installed and on PATH?)");
+  int status = 0;
+  waitpid(pid, &status, 0);
+  std::error_code ec;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    fs::remove(tmp, ec);
+    throw Error("outputs.mp4", fmt::format("ffmpeg failed encoding '{}'", pattern));
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) throw Error(out, "cannot move the encoded MP4 into place: " + ec.message());
+}
+
+std::vector<std::string> write_previews(const Shot& shot, int first, int last) {
+  std::vector<std::string> written;
+  const OutputPaths paths{shot.outputs.folder};
+  std::error_code ec;
+  for (int f = first; f <= last; ++f)
+    if (!fs::is_regular_file(paths.composite_png(f), ec)) return written;  // not all composited
+  if (shot.outputs.contact_sheet && shot.outputs.composite_png) {
+    // At most 12 frames, spread over the shot.
+    const int count = std::min(12, last - first + 1);
+    std::vector<Image<float>> thumbs;
+    for (int i = 0; i < count; ++i) {
+      const int f = count == 1 ? first : first + int((long(last - first) * i) / (count - 1));
+      thumbs.push_back(read_image_float(paths.composite_png(f)));
+    }
+    const Image<float> sheet = pipeline::contact_sheet(thumbs, 4, 320);
+    WriteOptions wo;
+    wo.format = SampleFormat::kU8;
+    write_image(paths.contact_sheet(), sheet.cview(), wo);
+    written.push_back(paths.contact_sheet());
+  }
+  if (shot.outputs.mp4) {
+    encode_mp4(shot.outputs.folder + "/composite/frame_%04d.png", first, shot.source.fps,
+               shot.outputs.crf, paths.mp4());
+    written.push_back(paths.mp4());
+  }
+  return written;
+}
+
+}  // namespace emaki::io

@@ -1,0 +1,70 @@
+// The file side of running a shot: the frames of its source (rendered from a glTF scene, or
+// read from a studio render's EXR sequence), its exemplars and paper, and the Store that keeps
+// layer results and per-frame outputs in the output folder (every write atomic), plus the
+// previews made at the end (contact sheet, MP4 through ffmpeg).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/frames.h"
+#include "pipeline/run.h"
+#include "pipeline/shot.h"
+#include "render/passes.h"
+
+namespace emaki::io {
+
+// The file of frame `frame` of a printf-style pattern ("frame_%04d.exr").
+std::string frame_file(const std::string& pattern, int frame);
+
+// The channel names a sequence source reads for `pass` (its mapping, or emaki's own names).
+std::vector<std::string> source_channels(const pipeline::Source& source, const render::PassInfo& pass);
+
+// The shot's frames. Errors name the shot file's keys (source.scene, source.clip, ...).
+std::unique_ptr<pipeline::FrameSource> open_frames(const pipeline::Shot& shot);
+
+// Every exemplar's painting and guide passes; errors name exemplars.NAME.*.
+std::map<std::string, pipeline::ExemplarImages> load_exemplars(const pipeline::Shot& shot);
+
+pipeline::CompositeInputs load_composite_inputs(const pipeline::Shot& shot);
+
+// The output folder's layout.
+struct OutputPaths {
+  std::string folder;
+  std::string layer_exr(const std::string& layer, int frame) const;
+  std::string layer_png(const std::string& layer, int frame) const;
+  std::string composite_png(int frame) const;
+  std::string composite_exr(int frame) const;
+  std::string layered_exr(int frame) const;
+  std::string mp4() const;
+  std::string contact_sheet() const;
+};
+
+class FileStore : public pipeline::Store {
+ public:
+  // Creates the folders and removes temporary files a killed run left behind.
+  explicit FileStore(const pipeline::Shot& shot);
+  bool has_layer(const pipeline::Layer& layer, int frame) const override;
+  Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
+  void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
+  bool has_frame(int frame) const override;
+  void write_frame(int frame, ImageView<const float> composite,
+                   const std::vector<ImageView<const float>>& layers,
+                   ImageView<const float> passes) override;
+  const OutputPaths& paths() const { return paths_; }
+
+ private:
+  const pipeline::Shot& shot_;
+  OutputPaths paths_;
+};
+
+// The contact sheet and the MP4 preview of the composited frames [first, last] (each when the
+// shot's outputs ask for it). Returns the files written.
+std::vector<std::string> write_previews(const pipeline::Shot& shot, int first, int last);
+
+// Encodes `pattern` (printf-style) frames [first, ...] into an H.264 MP4 with the ffmpeg binary.
+void encode_mp4(const std::string& pattern, int first, float fps, int crf, const std::string& out);
+
+}  // namespace emaki::io

@@ -1,0 +1,6 @@
+# The file side of a shot (shot file, frame sequences, layer store, previews). Its own target
+# so that io's image and glTF code does not carry toml++.
+emaki_module(shot_io
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/shot_file.cpp ${CMAKE_CURRENT_LIST_DIR}/shot_inputs.cpp
+  DEPS emaki_pipeline emaki_io emaki_core
+  PRIVATE_DEPS tomlplusplus::tomlplusplus fmt::fmt)

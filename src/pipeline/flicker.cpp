@@ -1,0 +1,47 @@
+#include "pipeline/flicker.h"
+
+#include <cmath>
+
+#include "core/check.h"
+#include "render/passes.h"
+
+namespace emaki::pipeline {
+
+FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> prev,
+                           ImageView<const float> cp, ImageView<const float> pp, int mask_channel) {
+  CHECK_EQ(cur.width, prev.width);
+  CHECK_EQ(cur.height, prev.height);
+  CHECK_EQ(cp.width, cur.width);
+  CHECK_EQ(pp.width, cur.width);
+  FrameFlicker out;
+  const int w = cur.width, h = cur.height;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* p = cp.at(x, y);
+      if (p[render::kAlpha] < 1.0f || p[render::kOutline] > 0.0f) continue;
+      if (mask_channel >= 0 && cur(x, y, mask_channel) < 1.0f) continue;
+      const float id = p[render::kObjectId];
+      if (id < 1.0f) continue;
+      const float sx = x + p[render::kMotion] , sy = y + p[render::kMotion + 1];
+      const int x0 = int(std::floor(sx)), y0 = int(std::floor(sy));
+      if (x0 < 0 || y0 < 0 || x0 + 1 >= w || y0 + 1 >= h) continue;
+      const float fx = sx - x0, fy = sy - y0;
+      bool ok = true;
+      double v = 0.0;
+      for (int j = 0; j < 2 && ok; ++j)
+        for (int i = 0; i < 2 && ok; ++i) {
+          const float* q = pp.at(x0 + i, y0 + j);
+          if (q[render::kAlpha] < 1.0f || q[render::kObjectId] != id || q[render::kOutline] > 0.0f) ok = false;
+          if (mask_channel >= 0 && prev(x0 + i, y0 + j, mask_channel) < 1.0f) ok = false;
+          v += (i ? fx : 1 - fx) * (j ? fy : 1 - fy) * prev(x0 + i, y0 + j, 0);
+        }
+      if (!ok) continue;
+      const double e = std::abs(double(cur(x, y, 0)) - v);
+      out.all.sum += e, ++out.all.pixels;
+      FlickerStats& s = id >= 2.0f ? out.objects : out.ground;
+      s.sum += e, ++s.pixels;
+    }
+  return out;
+}
+
+}  // namespace emaki::pipeline

@@ -1,0 +1,29 @@
+// Temporal error of a stylized sequence (emaki qa flicker): for each frame t after the first,
+// the mean absolute difference between B'(t) and B'(t-1) sampled where the renderer's motion
+// vectors say the same surface point was, over pixels visible in both frames.
+#pragma once
+
+#include "core/image.h"
+
+namespace emaki::pipeline {
+
+struct FlickerStats {
+  double sum = 0.0;
+  long pixels = 0;
+  double mean() const { return pixels ? sum / double(pixels) : 0.0; }
+};
+
+struct FrameFlicker {
+  int frame = 0;
+  FlickerStats all, objects, ground;  // objects: id >= 2; ground: id 1
+};
+
+// `current`/`previous`: layer values (channel 0 is used; a masked layer's coverage is its
+// channel `mask_channel`, -1 for none); passes in the layout of render/passes.h. A pixel counts
+// when it and the four pixels it samples in t-1 are fully covered, carry the same object id, no
+// line (silhouettes are where points hide) and, for a masked layer, lie inside both masks.
+FrameFlicker frame_flicker(ImageView<const float> current, ImageView<const float> previous,
+                           ImageView<const float> current_passes,
+                           ImageView<const float> previous_passes, int mask_channel);
+
+}  // namespace emaki::pipeline

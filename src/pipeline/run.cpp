@@ -1,0 +1,329 @@
+#include "pipeline/run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "composite/composite.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "render/passes.h"
+#include "synth/synthesizer.h"
+#include "temporal/advection.h"
+
+namespace emaki::pipeline {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A layer with its exemplar cut into what every frame's synthesis reads.
+struct PreparedLayer {
+  const Layer* layer = nullptr;
+  int value_channels = 1;
+  Image<float> style;                       // A': the touch (1 channel) or the painting's RGB
+  std::vector<Image<float>> source_guides;  // one per layer->guides entry
+};
+
+PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex) {
+  PreparedLayer p;
+  p.layer = &layer;
+  p.value_channels = layer.single_colour ? 1 : 3;
+  if (layer.single_colour) {
+    p.style = composite::touch(ex.painting.cview(), layer.channel);
+  } else {
+    if (ex.painting.channels() < 3)
+      throw Error(fmt::format("layers.{}.single_colour", layer.name),
+                  "false needs an RGB painting, its exemplar's painting is grey");
+    p.style = extract(ex.painting.cview(), 0, 3);
+  }
+  for (const GuideSpec& g : layer.guides) p.source_guides.push_back(extract_pass(ex.passes.cview(), g.pass));
+  return p;
+}
+
+synth::Params synth_params(const SynthSpec& s, uint64_t seed) {
+  synth::Params p;
+  p.patch_size = s.patch_size;
+  p.uniformity = s.uniformity;
+  p.pyramid_levels = s.pyramid_levels;
+  p.search_vote_iters = s.search_vote_iters;
+  p.patch_match_iters = s.patch_match_iters;
+  p.seed = seed;
+  return p;
+}
+
+// Seeds depend on (layer seed, frame, which transfer) only, so a resumed run draws exactly the
+// numbers an uninterrupted one would.
+uint64_t frame_seed(const Layer& l, int frame, int transfer) {
+  return hash_key(l.synth.seed, uint64_t(frame), uint64_t(transfer));
+}
+
+// One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
+// temporal chain continues.
+Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> passes, int frame,
+                              const Image<float>* previous, const Image<float>* previous_passes) {
+  const Layer& l = *p.layer;
+  const Image<float> mask = layer_mask(passes, l.mask);
+  const int n = p.value_channels;
+  if (!mask.empty()) {
+    bool any = false;
+    for (int y = 0; y < mask.height() && !any; ++y)
+      for (int x = 0; x < mask.width() && !any; ++x) any = mask(x, y) > 0.5f;
+    if (!any) {
+      Image<float> empty(passes.width, passes.height, n + 1);  // nothing to synthesize: transparent
+      return empty;
+    }
+  }
+  std::vector<Image<float>> targets;
+  synth::Inputs inputs;
+  inputs.style = p.style.cview();
+  inputs.style_name = fmt::format("exemplars.{}.painting", l.exemplar);
+  for (std::size_t i = 0; i < l.guides.size(); ++i) {
+    targets.push_back(extract_pass(passes, l.guides[i].pass));
+    inputs.guides.push_back({fmt::format("layers.{}.guides.{}", l.name, l.guides[i].pass),
+                             p.source_guides[i].cview(), targets.back().cview(), l.guides[i].weight});
+  }
+  Image<float> advected;
+  if (previous && previous_passes) {
+    const Image<float> guide_prev = advection_guide(previous_passes->cview(), l.temporal.guide);
+    const Image<float> guide_cur = advection_guide(passes, l.temporal.guide);
+    temporal::AdvectionInputs a;
+    a.previous_stylized = previous->cview();
+    a.value_channels = n;
+    a.previous_guide = guide_prev.cview();
+    a.current_guide = guide_cur.cview();
+    a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
+    if (!mask.empty()) a.current_mask = mask.cview();
+    advected = temporal::advect(a, synth_params(l.synth, frame_seed(l, frame, 1)));
+    inputs.guides.push_back({fmt::format("layers.{}.temporal", l.name), p.style.cview(),
+                             advected.cview(), l.temporal.weight});
+  }
+  if (!mask.empty()) inputs.target_mask = mask.cview();
+  synth::Result r = synth::synthesize(inputs, synth_params(l.synth, frame_seed(l, frame, 0)));
+  return std::move(r.image);
+}
+
+std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<std::string>& names) {
+  std::vector<const Layer*> out;
+  if (names.empty()) {
+    for (const Layer& l : shot.layers) out.push_back(&l);
+    return out;
+  }
+  for (const std::string& n : names) {
+    const Layer* l = shot.find_layer(n);
+    if (!l) {
+      std::string known;
+      for (const Layer& k : shot.layers) known += (known.empty() ? "" : ", ") + k.name;
+      throw Error("--layers", fmt::format("no layer '{}' in the shot (layers: {})", n, known));
+    }
+    if (std::find(out.begin(), out.end(), l) == out.end()) out.push_back(l);
+  }
+  return out;
+}
+
+void resolve_range(const Shot& shot, const RunOptions& o, int& a, int& b) {
+  a = o.first_frame < 0 ? shot.source.first_frame : o.first_frame;
+  b = o.last_frame < 0 ? shot.source.last_frame : o.last_frame;
+  if (a > b) throw Error("--frames", fmt::format("the range {}-{} is reversed", a, b));
+  if (a < shot.source.first_frame || b > shot.source.last_frame)
+    throw Error("--frames", fmt::format("{}-{} leaves the shot's frames {}-{}", a, b,
+                                        shot.source.first_frame, shot.source.last_frame));
+}
+
+}  // namespace
+
+Image<float> composite_frame(const Shot& shot, ImageView<const float> passes,
+                             const std::vector<ImageView<const float>>& layers,
+                             const CompositeInputs& ci) {
+  CHECK_EQ(layers.size(), shot.layers.size());
+  const Image<float> albedo = extract(passes, render::kAlbedo, 3);
+  std::vector<composite::LayerInput> inputs;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    composite::LayerInput in;
+    in.name = shot.layers[i].name;
+    in.value = layers[i];
+    in.value_channels = shot.layers[i].single_colour ? 1 : 3;
+    in.albedo = albedo.cview();
+    in.look = shot.layers[i].look;
+    inputs.push_back(in);
+  }
+  composite::Paper paper;
+  paper.texture = ci.paper.empty() ? ImageView<const float>{} : ci.paper.cview();
+  paper.scale = shot.compositing.paper_scale;
+  paper.color = shot.compositing.paper_color;
+  return composite::composite(inputs, paper, passes.width, passes.height);
+}
+
+RunReport run_shot(const Shot& shot, const FrameSource& frames,
+                   const std::map<std::string, ExemplarImages>& exemplars,
+                   const CompositeInputs& ci, Store& store, const RunOptions& o) {
+  int a = 0, b = 0;
+  resolve_range(shot, o, a, b);
+  const std::vector<const Layer*> selected = selected_layers(shot, o.layers);
+  std::vector<PreparedLayer> prepared;
+  for (const Layer* l : selected) prepared.push_back(prepare(*l, exemplars.at(l->exemplar)));
+
+  const int first = shot.source.first_frame;
+  auto needs = [&](const Layer& l, int f) { return (o.force && f >= a) || !store.has_layer(l, f); };
+  // The temporal chain continues from the last finished frame: start where the frame before
+  // is available.
+  int start = a;
+  for (const Layer* l : selected)
+    if (l->temporal.enabled) {
+      int s = a;
+      while (s > first && !store.has_layer(*l, s - 1)) --s;
+      start = std::min(start, s);
+    }
+
+  RunReport report;
+  report.first_frame = start;
+  report.last_frame = b;
+  int total = 0;
+  for (int f = start; f <= b; ++f)
+    for (const Layer* l : selected) total += needs(*l, f) ? 1 : 0;
+  const Clock::time_point t0 = Clock::now();
+  auto tick = [&](int f, const std::string& layer) {
+    if (!o.progress) return;
+    Progress p;
+    p.frame = f;
+    p.layer = layer;
+    p.done = report.synthesized;
+    p.total = total;
+    p.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    o.progress(p);
+  };
+
+  // Per layer: its frame f-1 result once computed or read (index parallel to `prepared`).
+  struct Held {
+    int frame = -1;
+    Image<float> value;
+  };
+  std::vector<Held> held(prepared.size());
+  Held prev_passes;
+  for (int f = start; f <= b; ++f) {
+    std::optional<Image<float>> passes;
+    auto get_passes = [&]() -> const Image<float>& {
+      if (!passes) passes = frames.passes(f);
+      return *passes;
+    };
+    bool changed = false;
+    std::vector<Held> now(prepared.size());
+    for (std::size_t i = 0; i < prepared.size(); ++i) {
+      const Layer& l = *prepared[i].layer;
+      now[i].frame = f;
+      if (!needs(l, f)) {
+        ++report.reused;
+        continue;  // read lazily, only if the chain or the composite needs it
+      }
+      const Image<float>* previous = nullptr;
+      const Image<float>* previous_passes = nullptr;
+      if (l.temporal.enabled && f > first) {
+        if (held[i].frame != f - 1 || held[i].value.empty()) {
+          held[i].frame = f - 1;
+          held[i].value = store.read_layer(l, f - 1);
+        }
+        if (prev_passes.frame != f - 1) prev_passes = {f - 1, frames.passes(f - 1)};
+        previous = &held[i].value;
+        previous_passes = &prev_passes.value;
+      }
+      tick(f, l.name);
+      now[i].value = synthesize_layer(prepared[i], get_passes().cview(), f, previous, previous_passes);
+      store.write_layer(l, f, now[i].value.cview());
+      ++report.synthesized;
+      changed = true;
+    }
+    if (f >= a && (changed || o.force || !store.has_frame(f))) {
+      bool complete = true;
+      std::vector<Image<float>> read_back;
+      read_back.reserve(shot.layers.size());  // views point into it: no reallocation
+      std::vector<ImageView<const float>> views;
+      for (const Layer& l : shot.layers) {
+        const auto it = std::find_if(prepared.begin(), prepared.end(),
+                                     [&](const PreparedLayer& p) { return p.layer == &l; });
+        if (it != prepared.end() && !now[it - prepared.begin()].value.empty()) {
+          views.push_back(now[it - prepared.begin()].value.cview());
+        } else if (store.has_layer(l, f)) {
+          read_back.push_back(store.read_layer(l, f));
+          views.push_back(read_back.back().cview());
+        } else {
+          complete = false;  // a layer left out with --layers that was never synthesized
+          break;
+        }
+      }
+      if (complete) {
+        tick(f, "");
+        const Image<float> comp = composite_frame(shot, get_passes().cview(), views, ci);
+        store.write_frame(f, comp.cview(), views, get_passes().cview());
+        ++report.composited;
+      }
+    }
+    for (std::size_t i = 0; i < prepared.size(); ++i) held[i] = std::move(now[i]);
+    if (passes) prev_passes = {f, std::move(*passes)};
+  }
+  return report;
+}
+
+int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInputs& ci,
+                Store& store, const RunOptions& o) {
+  int a = 0, b = 0;
+  resolve_range(shot, o, a, b);
+  int written = 0;
+  for (int f = a; f <= b; ++f) {
+    std::vector<Image<float>> values;
+    for (const Layer& l : shot.layers) {
+      if (!store.has_layer(l, f))
+        throw Error(fmt::format("layers.{}", l.name),
+                    fmt::format("frame {} has not been synthesized yet (run `emaki run` first)", f));
+      values.push_back(store.read_layer(l, f));
+    }
+    std::vector<ImageView<const float>> views;
+    for (const Image<float>& v : values) views.push_back(v.cview());
+    const Image<float> passes = frames.passes(f);
+    if (o.progress) {
+      Progress p;
+      p.frame = f;
+      p.done = f - a;
+      p.total = b - a + 1;
+      o.progress(p);
+    }
+    const Image<float> comp = composite_frame(shot, passes.cview(), views, ci);
+    store.write_frame(f, comp.cview(), views, passes.cview());
+    ++written;
+  }
+  return written;
+}
+
+Image<float> contact_sheet(const std::vector<Image<float>>& frames, int columns, int thumb_width) {
+  CHECK(!frames.empty());
+  CHECK_GT(columns, 0);
+  const int fw = frames[0].width(), fh = frames[0].height();
+  const int tw = std::min(thumb_width, fw);
+  const int th = std::max(1, int(std::lround(double(fh) * tw / fw)));
+  const int gap = 4;
+  const int rows = (int(frames.size()) + columns - 1) / columns;
+  const int cols = std::min<int>(columns, int(frames.size()));
+  Image<float> sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3);
+  sheet.fill(1.0f);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const Image<float>& f = frames[i];
+    CHECK_GE(f.channels(), 3);
+    const int ox = gap + int(i % columns) * (tw + gap), oy = gap + int(i / columns) * (th + gap);
+    // Box filter over the source pixels each thumbnail pixel covers.
+    for (int y = 0; y < th; ++y)
+      for (int x = 0; x < tw; ++x) {
+        const int x0 = x * fw / tw, x1 = std::max(x0 + 1, (x + 1) * fw / tw);
+        const int y0 = y * fh / th, y1 = std::max(y0 + 1, (y + 1) * fh / th);
+        for (int c = 0; c < 3; ++c) {
+          double s = 0;
+          for (int yy = y0; yy < y1; ++yy)
+            for (int xx = x0; xx < x1; ++xx) s += f(xx, yy, c);
+          sheet(ox + x, oy + y, c) = float(s / ((x1 - x0) * (y1 - y0)));
+        }
+      }
+  }
+  return sheet;
+}
+
+}  // namespace emaki::pipeline

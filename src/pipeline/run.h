@@ -1,0 +1,90 @@
+// Running a shot: layers x frames, each layer synthesized from its exemplar under its mask, the
+// temporal chain (advection of the previous stylized frame), compositing, and resuming after
+// the last finished frame. Files are the Store's business (io/); this code only decides what
+// to compute and in which order.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+#include "pipeline/frames.h"
+#include "pipeline/shot.h"
+
+namespace emaki::pipeline {
+
+// An exemplar ready for synthesis: its painting (RGB float, as in its file) and the guide passes
+// it was painted over (kChannelCount channels, the painting's size).
+struct ExemplarImages {
+  Image<float> painting;
+  Image<float> passes;
+};
+
+// Where layer results and frame outputs live. A layer frame is finished once has_layer says so:
+// writes must be atomic so that a killed run never leaves a half frame that looks finished.
+class Store {
+ public:
+  virtual ~Store() = default;
+  virtual bool has_layer(const Layer& layer, int frame) const = 0;
+  // The layer's values (1 or 3 channels) and, for a masked layer, the mask coverage last.
+  virtual Image<float> read_layer(const Layer& layer, int frame) const = 0;
+  virtual void write_layer(const Layer& layer, int frame, ImageView<const float> value) = 0;
+  // True when every per-frame output (composite, layered EXR, ...) of `frame` exists.
+  virtual bool has_frame(int frame) const = 0;
+  // `composite` is RGBA; `layers` are in shot.layers order.
+  virtual void write_frame(int frame, ImageView<const float> composite,
+                           const std::vector<ImageView<const float>>& layers,
+                           ImageView<const float> passes) = 0;
+};
+
+struct Progress {
+  int frame = 0;
+  std::string layer;    // empty: compositing
+  int done = 0, total = 0;  // layer-frames synthesized so far / to synthesize in this run
+  double elapsed_s = 0.0;
+};
+
+struct RunOptions {
+  int first_frame = -1, last_frame = -1;  // -1: the shot's range
+  std::vector<std::string> layers;        // empty: all
+  bool force = false;                     // synthesize again even when finished
+  std::function<void(const Progress&)> progress;
+};
+
+struct RunReport {
+  int synthesized = 0;  // layer-frames synthesized
+  int reused = 0;       // layer-frames read back (finished before)
+  int composited = 0;   // frames composited
+  int first_frame = 0, last_frame = 0;  // frames visited (the chain may start before --frames)
+};
+
+// The inputs of compositing that do not change from frame to frame.
+struct CompositeInputs {
+  Image<float> paper;  // empty: flat paper colour
+};
+
+// Runs (or resumes) the shot over the requested frames and layers. `exemplars` maps exemplar
+// names to their images. Throws emaki::Error for what a user can fix (a size that does not
+// match, an unknown layer in options.layers).
+RunReport run_shot(const Shot& shot, const FrameSource& frames,
+                   const std::map<std::string, ExemplarImages>& exemplars,
+                   const CompositeInputs& composite_inputs, Store& store,
+                   const RunOptions& options);
+
+// Re-composites finished layer frames with the shot's current colours, blends and paper,
+// without synthesizing. Returns the number of frames written.
+int recomposite(const Shot& shot, const FrameSource& frames,
+                const CompositeInputs& composite_inputs, Store& store, const RunOptions& options);
+
+// The composite of one frame: the layers (shot.layers order) over the paper.
+Image<float> composite_frame(const Shot& shot, ImageView<const float> passes,
+                             const std::vector<ImageView<const float>>& layers,
+                             const CompositeInputs& composite_inputs);
+
+// A grid of thumbnails (RGB), `columns` wide, each thumbnail `thumb_width` pixels wide.
+Image<float> contact_sheet(const std::vector<Image<float>>& frames, int columns, int thumb_width);
+
+}  // namespace emaki::pipeline

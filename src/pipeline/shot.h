@@ -1,0 +1,150 @@
+// A shot, as the shot file describes it (docs/shot_file.md is the table of every key): where
+// the guide passes come from, the exemplars, the layers and how they are composited, and what
+// is written. Plain data, free of I/O: io/shot_file.cpp fills it, pipeline/ runs it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "composite/composite.h"
+#include "exemplar/reference_sphere.h"
+#include "render/renderer.h"
+#include "scene/shot.h"
+
+namespace emaki::pipeline {
+
+enum class SourceKind {
+  kScene,     // a glTF scene rendered by emaki's own renderer
+  kSequence,  // a studio render: one multilayer EXR per frame
+};
+
+// One pass of passes.h read from a studio render's channels.
+struct ChannelMapping {
+  std::string pass;                   // a pass name of passes.h ("normal", "albedo", ...)
+  std::vector<std::string> channels;  // the file's channel names, as many as the pass has
+};
+
+struct Source {
+  SourceKind kind = SourceKind::kScene;
+  int first_frame = 0, last_frame = 0;  // inclusive
+  int width = 0, height = 0;
+  float fps = 24.0f;
+  // kScene
+  std::string scene_path;
+  scene::ShotSpec shot;           // camera, light, ground, clip; frames mirror first/last_frame
+  render::RenderOptions render;   // width/height mirror the source's size
+  // kSequence
+  std::string pattern;            // printf-style with one integer, e.g. renders/frame_%04d.exr
+  std::vector<ChannelMapping> channels;  // passes read under other names than emaki's
+};
+
+enum class ExemplarKind {
+  kMatcap,    // a painted sphere; its guides are the reference sphere's passes, fitted to it
+  kKeyframe,  // a painted frame of the shot (or any scene) with its pass file
+};
+
+struct Exemplar {
+  std::string name;
+  ExemplarKind kind = ExemplarKind::kMatcap;
+  std::string painting;
+  exemplar::ReferenceSpec reference;  // kMatcap; width/height come from the painting
+  int aa = 3;                          // kMatcap: supersampling of the reference passes
+  std::string passes;                  // kKeyframe: multilayer EXR with emaki's channel names
+};
+
+struct GuideSpec {
+  std::string pass;  // a pass name of passes.h
+  float weight = 1.0f;
+};
+
+// Where a layer is synthesized; the rest of the frame stays empty (transparent).
+enum class MaskKind {
+  kNone,     // everywhere
+  kObjects,  // covered by scene objects (not ground, not background)
+  kLines,    // near the outline pass's lines
+  kShadow,   // in cast shadow or facing away from the light
+  kLit,      // the complement of kShadow over covered pixels
+};
+
+struct MaskSpec {
+  MaskKind kind = MaskKind::kNone;
+  float dilate = 0.0f;     // grow the mask by this many pixels
+  float threshold = 0.5f;  // pass value above which a pixel is in the mask
+};
+
+enum class AdvectionGuide {
+  kPosition,      // the paper's: normalised world position
+  kRestPosition,  // rest-pose position plus object ids: follows the material point
+};
+
+struct TemporalSpec {
+  bool enabled = true;
+  float weight = 1.0f;  // weight of the temporal guide pair in the main transfer
+  AdvectionGuide guide = AdvectionGuide::kRestPosition;
+};
+
+struct SynthSpec {
+  int patch_size = 5;
+  float uniformity = 3500.0f;
+  int pyramid_levels = -1;
+  int search_vote_iters = -1;
+  int patch_match_iters = -1;
+  uint64_t seed = 1;
+};
+
+struct Layer {
+  std::string name;
+  std::string kind = "custom";  // base, outline, shadow or custom: sets the defaults
+  std::string exemplar;         // an Exemplar's name
+  std::vector<GuideSpec> guides;
+  SynthSpec synth;
+  bool single_colour = true;
+  int channel = -1;  // -1: luminance; 0..2: that channel of the painting
+  TemporalSpec temporal;
+  MaskSpec mask;
+  composite::LayerLook look;
+  int order = 0;  // compositing order, bottom first; ties keep the file's order
+};
+
+struct Compositing {
+  std::string paper;  // texture file; empty: flat paper_color
+  float paper_scale = 1.0f;
+  composite::Color paper_color{1.0f, 1.0f, 1.0f};
+};
+
+struct Outputs {
+  std::string folder;
+  // layers/<layer>/<layer>_%04d.exr (float value + mask) is always written: resuming and
+  // `emaki composite` read it.
+  bool layer_png = true;      // layers/<layer>/<layer>_%04d.png, 16-bit
+  bool composite_png = true;  // composite/frame_%04d.png, 16-bit
+  bool composite_exr = false; // composite/frame_%04d.exr
+  bool layered_exr = true;    // layered/frame_%04d.exr: every layer and pass
+  bool mp4 = true;            // preview.mp4 (ffmpeg, libx264)
+  bool contact_sheet = true;  // contact_sheet.png
+  int crf = 20;               // libx264 quality, [0, 51]
+};
+
+struct Shot {
+  std::string path;  // the shot file; relative paths inside it are resolved against its folder
+  Source source;
+  std::vector<Exemplar> exemplars;
+  std::vector<Layer> layers;  // in compositing order (bottom first)
+  Compositing compositing;
+  Outputs outputs;
+  int threads = 0;
+
+  const Exemplar* find_exemplar(const std::string& name) const {
+    for (const Exemplar& e : exemplars)
+      if (e.name == name) return &e;
+    return nullptr;
+  }
+  const Layer* find_layer(const std::string& name) const {
+    for (const Layer& l : layers)
+      if (l.name == name) return &l;
+    return nullptr;
+  }
+};
+
+}  // namespace emaki::pipeline

@@ -1,0 +1,40 @@
+#include "temporal/advection.h"
+
+#include "core/check.h"
+
+namespace emaki::temporal {
+
+Image<float> advect(const AdvectionInputs& in, const synth::Params& params) {
+  const ImageView<const float> prev = in.previous_stylized;
+  CHECK(!prev.empty());
+  const int n = in.value_channels;
+  CHECK(n == 1 || n == 3);
+  CHECK_GE(prev.channels, n);
+  const bool masked = prev.channels > n;
+  // The style is B'(t-1)'s value, with the empty value where it had no content, so that the
+  // advection never copies the transparent area's zeros into the current frame.
+  Image<float> style(prev.width, prev.height, n);
+  for (int y = 0; y < prev.height; ++y)
+    for (int x = 0; x < prev.width; ++x) {
+      const float* p = prev.at(x, y);
+      const float a = masked ? p[n] : 1.0f;
+      for (int c = 0; c < n; ++c) style(x, y, c) = a * p[c] + (1.0f - a) * in.empty_value;
+    }
+  synth::Inputs inputs;
+  inputs.style = style.cview();
+  inputs.style_name = "previous frame";
+  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, 1.0f});
+  if (in.current_mask) inputs.target_mask = *in.current_mask;
+  synth::Result r = synth::synthesize(inputs, params);
+  if (r.image.channels() == n) return std::move(r.image);
+  // Drop the alpha the mask added; outside the mask the value is the empty value.
+  Image<float> out(r.image.width(), r.image.height(), n);
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) {
+      const float a = r.image(x, y, n);
+      for (int c = 0; c < n; ++c) out(x, y, c) = a * r.image(x, y, c) + (1.0f - a) * in.empty_value;
+    }
+  return out;
+}
+
+}  // namespace emaki::temporal
