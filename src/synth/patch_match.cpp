@@ -180,40 +180,39 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
 
 }  // namespace
 
-std::vector<int32_t> occupancy_window_sums(const PatchMatchLevel& L, int p) {
+void occupancy_window_sums(const PatchMatchLevel& L, int p, std::vector<int32_t>& sums,
+                           std::vector<int32_t>& scratch) {
   // Histogram of patch centres, then a separable triangle filter (p - |d|, |d| < p).
-  Image<int32_t> count(L.sw, L.sh, 1);
+  const std::size_t n = std::size_t(L.sw) * L.sh;
+  sums.assign(n, 0);
+  scratch.resize(n);
   for (int y = 0; y < L.th; ++y)
     for (int x = 0; x < L.tw; ++x)
       if (is_active(L, x, y)) {
         const int32_t* m = L.nnf->at(x, y);
-        count(m[0], m[1]) += 1;
+        sums[std::size_t(m[1]) * L.sw + m[0]] += 1;
       }
-  Image<int32_t> tmp(L.sw, L.sh, 1);
+  parallel_rows(L.sh, 64, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const int32_t* count = sums.data() + std::size_t(y) * L.sw;
+      int32_t* out = scratch.data() + std::size_t(y) * L.sw;
+      for (int x = 0; x < L.sw; ++x) {
+        int32_t s = 0;
+        for (int d = std::max(-(p - 1), -x); d <= std::min(p - 1, L.sw - 1 - x); ++d)
+          s += (p - std::abs(d)) * count[x + d];
+        out[x] = s;
+      }
+    }
+  });
   parallel_rows(L.sh, 64, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < L.sw; ++x) {
         int32_t s = 0;
-        for (int d = -(p - 1); d <= p - 1; ++d) {
-          const int xx = x + d;
-          if (xx >= 0 && xx < L.sw) s += (p - std::abs(d)) * count(xx, y);
-        }
-        tmp(x, y) = s;
+        for (int d = std::max(-(p - 1), -y); d <= std::min(p - 1, L.sh - 1 - y); ++d)
+          s += (p - std::abs(d)) * scratch[std::size_t(y + d) * L.sw + x];
+        sums[std::size_t(y) * L.sw + x] = s;
       }
   });
-  std::vector<int32_t> out(std::size_t(L.sw) * L.sh);
-  parallel_rows(L.sh, 64, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < L.sw; ++x) {
-        int32_t s = 0;
-        for (int d = -(p - 1); d <= p - 1; ++d) {
-          const int yy = y + d;
-          if (yy >= 0 && yy < L.sh) s += (p - std::abs(d)) * tmp(x, yy);
-        }
-        out[std::size_t(y) * L.sw + x] = s;
-      }
-  });
-  return out;
 }
 
 void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
@@ -257,11 +256,12 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
     snap_rows.push_back(e);
   }
   Image<int32_t> snap(L.tw, std::max<int>(1, int(snap_rows.size())), 2);
+  std::vector<int32_t> occ, occ_scratch;
   for (int iter = 0; iter < C.iterations; ++iter) {
     for (std::size_t k = 0; k < snap_rows.size(); ++k)
       std::memcpy(snap.row(int(k)), L.nnf->row(snap_rows[k]), std::size_t(L.tw) * 2 * sizeof(int32_t));
-    const std::vector<int32_t> occ = occ_scale > 0.0f ? occupancy_window_sums(L, p)
-                                                      : std::vector<int32_t>(std::size_t(L.sw) * L.sh, 0);
+    if (occ_scale > 0.0f) occupancy_window_sums(L, p, occ, occ_scratch);
+    else occ.assign(std::size_t(L.sw) * L.sh, 0);
     const Sweep sweep{L, C, occ.data(), snap, snap_slot, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
                       p * L.src->channels()};
     parallel_rows(L.th, band, [&](int y0, int y1) {

@@ -54,6 +54,8 @@ void run_patch_match(const PatchMatchLevel& level, const PatchMatchConfig& confi
 
 // Occupancy summed over the patch window of each source centre, sw * sh values row by row
 // (exposed for tests).
-std::vector<int32_t> occupancy_window_sums(const PatchMatchLevel& level, int patch_size);
+// `scratch` is a work buffer; both are resized as needed (reused across sweeps).
+void occupancy_window_sums(const PatchMatchLevel& level, int patch_size,
+                           std::vector<int32_t>& sums, std::vector<int32_t>& scratch);
 
 }  // namespace emaki::synth

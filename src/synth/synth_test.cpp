@@ -180,7 +180,8 @@ TEST(Occupancy, WindowSumsMatchBruteForce) {
     }
   PatchMatchLevel L;
   L.sw = sw, L.sh = sh, L.tw = tw, L.th = th, L.nnf = &nnf;
-  const auto sums = occupancy_window_sums(L, p);
+  std::vector<int32_t> sums, scratch;
+  occupancy_window_sums(L, p, sums, scratch);
   // Brute force: omega(s) = target patches covering s; window sum = sum of omega over the patch.
   std::vector<int> omega(sw * sh, 0);
   for (int y = 0; y < th; ++y)

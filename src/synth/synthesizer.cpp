@@ -355,29 +355,6 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params) : state_(std::m
         }
     }
   }
-  for (int l = 1; l < levels; ++l) {
-    Level& c = pyr[l];
-    const Level& f = pyr[l - 1];
-    c.src = downsample(f.src.cview());
-    decimate_channels(f.src.cview(), c.src, 0, ns);
-    c.src_style.reset(c.src.width(), c.src.height(), ns);
-    if (l == 1) {
-      for_each_row(in.style, 0, sh, [&](int y, const float* row) {
-        if (y % 2 != 0 || y / 2 >= c.src_style.height()) return;
-        for (int x = 0; x < c.src_style.width(); ++x)
-          for (int k = 0; k < ns; ++k) c.src_style(x, y / 2, k) = row[std::min(2 * x, sw - 1) * ns + k];
-      });
-    } else {
-      decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
-    }
-    Image<int16_t> t = downsample(interior(f.tgt, border));
-    c.sw = c.src.width(), c.sh = c.src.height(), c.tw = t.width(), c.th = t.height();
-    c.tgt.reset(c.tw + 2 * border, c.th + 2 * border, layout.channels);
-    for (int y = 0; y < c.th; ++y)
-      std::copy(t.row(y), t.row(y) + std::size_t(c.tw) * layout.channels, c.tgt.at(border, y + border));
-    pad_replicate(c.tgt, border, ns, layout.channels);
-    if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
-  }
 }
 
 Result Synthesizer::run(const OutputRequest& request) {
@@ -392,6 +369,32 @@ Result Synthesizer::run(const OutputRequest& request) {
   const PatchSsdFn ssd = best_patch_ssd();
   std::vector<Level>& pyr = st.pyr;
   const std::vector<LevelSchedule>& schedule = st.schedule;
+
+  // The coarse levels come from the finest features, built here rather than in the constructor
+  // so that the caller has already freed the guide images.
+  for (int l = 1; l < levels; ++l) {
+    Level& c = pyr[l];
+    const Level& f = pyr[l - 1];
+    c.src = downsample(f.src.cview());
+    decimate_channels(f.src.cview(), c.src, 0, ns);
+    c.src_style.reset(c.src.width(), c.src.height(), ns);
+    if (l == 1) {
+      for_each_row(st.style, 0, st.sh, [&](int y, const float* row) {
+        if (y % 2 != 0 || y / 2 >= c.src_style.height()) return;
+        for (int x = 0; x < c.src_style.width(); ++x)
+          for (int k = 0; k < ns; ++k) c.src_style(x, y / 2, k) = row[std::min(2 * x, st.sw - 1) * ns + k];
+      });
+    } else {
+      decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
+    }
+    Image<int16_t> t = downsample(interior(f.tgt, border));
+    c.sw = c.src.width(), c.sh = c.src.height(), c.tw = t.width(), c.th = t.height();
+    c.tgt.reset(c.tw + 2 * border, c.th + 2 * border, layout.channels);
+    for (int y = 0; y < c.th; ++y)
+      std::copy(t.row(y), t.row(y) + std::size_t(c.tw) * layout.channels, c.tgt.at(border, y + border));
+    pad_replicate(c.tgt, border, ns, layout.channels);
+    if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
+  }
 
   Image<int32_t> nnf;
   Image<float> err;

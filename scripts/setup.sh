@@ -1,0 +1,14 @@
+#!/bin/sh
+# Installs the Debian 12 packages emaki builds with (skips those already installed).
+set -e
+PKGS="build-essential cmake pkg-config libopenimageio-dev openimageio-tools libopencv-core-dev
+libopenexr-dev libtinygltf-dev libtbb-dev libcli11-dev libtomlplusplus-dev libfmt-dev
+libglm-dev libgtest-dev libgmock-dev libbenchmark-dev ffmpeg"
+missing=""
+for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
+if [ -n "$missing" ]; then
+  echo "setup: installing$missing"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
+fi
