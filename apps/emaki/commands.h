@@ -12,6 +12,9 @@ using Args = std::vector<std::string>;
 int run_synth(const Args& args);
 int run_render(const Args& args);
 int run_template(const Args& args);
+int run_run(const Args& args);
+int run_composite(const Args& args);
+int run_qa(const Args& args);
 
 struct Command {
   const char* name;

@@ -16,6 +16,11 @@ const std::vector<Command>& commands() {
       {"render", "guide passes of a glTF scene, one multilayer EXR per frame", run_render},
       {"template", "reference sphere passes and a paint template (or fit them to a painting)",
        run_template},
+      {"run", "a whole shot from its shot file: layers, temporal chain, compositing, previews",
+       run_run},
+      {"composite", "re-colour a shot's finished layers without synthesizing again",
+       run_composite},
+      {"qa", "quality checks: 'emaki qa flicker SHOT --layer NAME'", run_qa},
   };
   return list;
 }
