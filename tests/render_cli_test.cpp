@@ -135,6 +135,20 @@ TEST_F(RenderCli, TextureThatDoesNotDecode) {
   expect_failure("render " + scene + " --size 64x48 --out " + out(), "texture.gltf", "image");
 }
 
+TEST_F(RenderCli, RequiredExtensionNotSupported) {
+  std::string text = triangle_gltf(kTriangleData, 3);
+  text.insert(1, R"("extensionsUsed":["KHR_draco_mesh_compression"],)"
+                 R"("extensionsRequired":["KHR_draco_mesh_compression"],)");
+  const std::string scene = write("draco.gltf", text);
+  expect_failure("render " + scene + " --size 64x48 --out " + out(), "draco.gltf",
+                 "KHR_draco_mesh_compression");
+}
+
+TEST_F(RenderCli, TooManySamples) {
+  expect_failure("render " + kScenes + "Fox.glb --size 16000x9000 --aa 3 --out " + out(), "--aa",
+                 "lower --aa or --size");
+}
+
 TEST_F(RenderCli, EmptyScene) {
   const std::string scene =
       write("empty.gltf",

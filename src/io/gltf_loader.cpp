@@ -571,6 +571,13 @@ Scene load_gltf(const std::string& path) {
     std::string message = one_line(err.empty() ? "could not be parsed" : err);
     throw Error(path, "not a valid glTF file: " + message);
   }
+  // Extensions the file cannot be drawn without: only those whose data we read are accepted.
+  for (const std::string& ext_name : model.extensionsRequired) {
+    if (ext_name != "KHR_mesh_quantization" && ext_name != "KHR_materials_unlit" &&
+        ext_name != "KHR_texture_transform" && ext_name.rfind("KHR_materials_", 0) != 0)
+      throw Error(path, fmt::format("requires the glTF extension {}, which is not supported",
+                                    ext_name));
+  }
   return Loader(path, model).load();
 }
 

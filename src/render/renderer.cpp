@@ -21,6 +21,8 @@ namespace {
 constexpr int kGroundObject = 1;
 constexpr int kGroundMaterial = 1;
 constexpr int kFirstSceneId = 2;
+// 8K at 3x3 samples per pixel; more would need gigabytes more of sample buffers.
+constexpr double kMaxSamples = 7680.0 * 4320.0 * 9.0;
 
 Bounds cube_around(const Bounds& b) {
   if (b.empty()) return {glm::vec3(-1.0f), glm::vec3(1.0f)};
@@ -376,6 +378,13 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
   CHECK_GT(options_.width, 0);
   CHECK_GT(options_.height, 0);
   options_.aa = std::clamp(options_.aa, 1, 4);
+  // The visibility buffer holds 16 bytes per sample for the whole frame.
+  const double samples = double(options_.width) * options_.height * options_.aa * options_.aa;
+  if (samples > kMaxSamples)
+    throw Error("--aa", fmt::format("{}x{} pixels with {}x{} samples each need {:.1f} GB of sample "
+                                    "buffers (limit {:.1f} GB); lower --aa or --size",
+                                    options_.width, options_.height, options_.aa, options_.aa,
+                                    samples * 16 / 1e9, kMaxSamples * 16 / 1e9));
   if (!(shot_.fps > 0.0f)) throw Error("--fps", fmt::format("must be > 0, got {}", shot_.fps));
   if (!shot_.clip.empty()) {
     animation_ = scene.find_animation(shot_.clip);
