@@ -451,6 +451,7 @@ KindDefaults kind_defaults(const std::string& kind) {
   KindDefaults d;
   if (kind == "base") {
     d.guides = {{"normal", 1.0f}, {"diffuse", 1.0f}};
+    d.mask = {pipeline::MaskKind::kCovered, 0.0f, 0.5f};
     d.look.source = composite::ColorSource::kAlbedo;
   } else if (kind == "shadow") {
     d.guides = {{"diffuse", 1.0f}, {"shadow", 1.0f}};
@@ -527,11 +528,13 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
                                        : pipeline::AdvectionGuide::kRestPosition;
   l.mask = d.mask;
   const std::string mask = r.choice("mask",
-                                    d.mask.kind == pipeline::MaskKind::kLines    ? "lines"
-                                    : d.mask.kind == pipeline::MaskKind::kShadow ? "shadow"
-                                                                                 : "none",
-                                    {"none", "objects", "lines", "shadow", "lit"});
+                                    d.mask.kind == pipeline::MaskKind::kLines     ? "lines"
+                                    : d.mask.kind == pipeline::MaskKind::kShadow  ? "shadow"
+                                    : d.mask.kind == pipeline::MaskKind::kCovered ? "covered"
+                                                                                  : "none",
+                                    {"none", "covered", "objects", "lines", "shadow", "lit"});
   l.mask.kind = mask == "none"      ? pipeline::MaskKind::kNone
+                : mask == "covered" ? pipeline::MaskKind::kCovered
                 : mask == "objects" ? pipeline::MaskKind::kObjects
                 : mask == "lines"   ? pipeline::MaskKind::kLines
                 : mask == "shadow"  ? pipeline::MaskKind::kShadow

@@ -78,6 +78,7 @@ Image<float> layer_mask(ImageView<const float> passes, const MaskSpec& spec) {
       bool in = false;
       switch (spec.kind) {
         case MaskKind::kNone: in = true; break;
+        case MaskKind::kCovered: in = covered; break;
         case MaskKind::kObjects: in = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 2.0f; break;
         case MaskKind::kLines: in = p[render::kOutline] > spec.threshold; break;
         case MaskKind::kShadow: in = shadowed; break;

@@ -61,7 +61,8 @@ struct GuideSpec {
 // Where a layer is synthesized; the rest of the frame stays empty (transparent).
 enum class MaskKind {
   kNone,     // everywhere
-  kObjects,  // covered by scene objects (not ground, not background)
+  kCovered,  // scene objects and the ground (not the background)
+  kObjects,  // scene objects only
   kLines,    // near the outline pass's lines
   kShadow,   // in cast shadow or facing away from the light
   kLit,      // the complement of kShadow over covered pixels
