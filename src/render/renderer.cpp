@@ -422,8 +422,10 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
     if (f == shot_.first_frame) rest_box_ = cube_around(scene::rest_bounds(posed));
   }
   position_box_ = cube_around(shot_bounds_);
-  ground_height_ =
-      shot_.ground.auto_height && !shot_bounds_.empty() ? shot_bounds_.lo.y : shot_.ground.height;
+  // Just under the lowest point, so an object's flat bottom does not z-fight with the ground.
+  ground_height_ = shot_.ground.auto_height && !shot_bounds_.empty()
+                       ? shot_bounds_.lo.y - 1e-4f * glm::length(shot_bounds_.size())
+                       : shot_.ground.height;
   light_ = scene::light_direction(shot_, camera(float(shot_.first_frame)));
 }
 

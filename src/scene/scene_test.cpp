@@ -164,5 +164,31 @@ TEST(Shot, AutoCameraFramesTheBounds) {
   EXPECT_LT(c.z, -1.0f);
 }
 
+TEST(Shot, GltfCameraFollowsItsAnimatedNode) {
+  Scene s;
+  CameraDef def;
+  def.yfov = 0.5f;
+  s.cameras.push_back(def);
+  Node cam;
+  cam.camera = 0;
+  cam.translation = {0, 0, 5};
+  s.nodes.push_back(cam);
+  s.roots = {0};
+  Animation a;
+  a.samplers.push_back(make_sampler(Interpolation::kLinear, {0, 1}, {0, 0, 5, 2, 0, 5}, 3));
+  a.channels.push_back({0, AnimPath::kTranslation, 0});
+  a.end = 1;
+  s.animations.push_back(a);
+  ShotSpec shot;
+  shot.camera.mode = CameraSpec::Mode::kGltf;
+  shot.camera.gltf_node = 0;
+  const ViewCamera cam0 = camera_at(shot, s, evaluate_pose(s, 0, 0.5f), Bounds{}, 0.0f, 1.0f);
+  EXPECT_NEAR(cam0.tan_half_fov, std::tan(0.25f), 1e-6f);
+  expect_near(cam0.position(), {1, 0, 5});
+  // glTF cameras look down their local -Z: the world point (1, 0, 0) is straight ahead.
+  const glm::vec3 ahead = glm::vec3(cam0.view * glm::vec4(1, 0, 0, 1));
+  expect_near(ahead, {0, 0, -5});
+}
+
 }  // namespace
 }  // namespace emaki::scene
