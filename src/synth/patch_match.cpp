@@ -37,25 +37,30 @@ void add_triangle(int32_t* buf, int sw, int sh, int cx, int cy, int p, int sign)
 
 // A band-private occupancy delta, zero between uses. Pooled so that a sweep allocates no
 // source-sized buffers; which buffer a band gets does not matter since each starts at zero.
+struct DeltaBuffers {
+  std::vector<int32_t> delta;
+  std::vector<uint8_t> dirty;
+};
+
 class DeltaPool {
  public:
-  explicit DeltaPool(std::size_t n) : n_(n) {}
-  std::vector<int32_t> take() {
+  DeltaPool(std::size_t n, std::size_t blocks) : n_(n), blocks_(blocks) {}
+  DeltaBuffers take() {
     std::lock_guard lock(mutex_);
-    if (free_.empty()) return std::vector<int32_t>(n_, 0);
+    if (free_.empty()) return {std::vector<int32_t>(n_, 0), std::vector<uint8_t>(blocks_, 0)};
     auto v = std::move(free_.back());
     free_.pop_back();
     return v;
   }
-  void give(std::vector<int32_t>&& v) {
+  void give(DeltaBuffers&& v) {
     std::lock_guard lock(mutex_);
     free_.push_back(std::move(v));
   }
 
  private:
-  std::size_t n_;
+  std::size_t n_, blocks_;
   std::mutex mutex_;
-  std::vector<std::vector<int32_t>> free_;
+  std::vector<DeltaBuffers> free_;
 };
 
 struct Sweep {
@@ -70,14 +75,29 @@ struct Sweep {
   int row_elems;
 };
 
+// Occupancy deltas are tracked per 8x8 block of source centres: most candidates land in blocks
+// the band never touched, and a glance at this small map saves a cache miss in the big one.
+inline constexpr int kDirtyShift = 3;
+
 struct Band {
   int32_t* delta;
-  std::vector<int32_t> changes;  // (centre index, sign) pairs to undo the delta afterwards
+  uint8_t* dirty;  // per block: has the delta any non-zero value there
+  int dirty_stride;
+  std::vector<int32_t> changes;  // (centre x, centre y, sign) triples to undo the delta afterwards
 };
 
 inline float occupancy(const Sweep& S, const Band& band, int cx, int cy) {
   const std::ptrdiff_t i = std::ptrdiff_t(cy) * S.L.sw + cx;
-  return S.occ_scale * float(S.occ[i] + band.delta[i]);
+  const bool dirty = band.dirty[(cy >> kDirtyShift) * band.dirty_stride + (cx >> kDirtyShift)];
+  return S.occ_scale * float(S.occ[i] + (dirty ? band.delta[i] : 0));
+}
+
+void mark_dirty(Band& band, int sw, int sh, int cx, int cy, int p) {
+  const int reach = p - 1;
+  const int bx0 = std::max(0, cx - reach) >> kDirtyShift, bx1 = std::min(sw - 1, cx + reach) >> kDirtyShift;
+  const int by0 = std::max(0, cy - reach) >> kDirtyShift, by1 = std::min(sh - 1, cy + reach) >> kDirtyShift;
+  for (int by = by0; by <= by1; ++by)
+    for (int bx = bx0; bx <= bx1; ++bx) band.dirty[by * band.dirty_stride + bx] = 1;
 }
 
 // Brings a candidate's source patch and occupancy into cache ahead of its evaluation: the
@@ -86,7 +106,8 @@ inline float occupancy(const Sweep& S, const Band& band, int cx, int cy) {
 inline void prefetch_candidate(const Sweep& S, const Band& band, int cx, int cy) {
   const std::ptrdiff_t i = std::ptrdiff_t(cy) * S.L.sw + cx;
   __builtin_prefetch(S.occ + i);
-  __builtin_prefetch(band.delta + i);
+  if (band.dirty[(cy >> kDirtyShift) * band.dirty_stride + (cx >> kDirtyShift)])
+    __builtin_prefetch(band.delta + i);
   const int16_t* s = S.L.src->at(cx - S.r, cy - S.r);
   const int row_bytes = S.row_elems * int(sizeof(int16_t));
   for (int j = 0; j <= 2 * S.r; ++j) {
@@ -120,6 +141,8 @@ inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int 
     const int p = 2 * S.r + 1;
     add_triangle(band.delta, L.sw, L.sh, n[0], n[1], p, -1);
     add_triangle(band.delta, L.sw, L.sh, cx, cy, p, +1);
+    mark_dirty(band, L.sw, L.sh, n[0], n[1], p);
+    mark_dirty(band, L.sw, L.sh, cx, cy, p);
     band.changes.insert(band.changes.end(), {n[0], n[1], -1, cx, cy, +1});
     cur_occ = occupancy(S, band, cx, cy);
   }
@@ -140,40 +163,49 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
   for (int rad = max_rad; rad >= 1 && num_radii < 32; rad /= 2) radii[num_radii++] = rad;
   const int ys = forward ? y0 : y1 - 1, ye = forward ? y1 : y0 - 1;
   const int xs = forward ? 0 : L.tw - 1, xe = forward ? L.tw : -1;
+  // Random candidates are drawn one pixel ahead, around that pixel's match as the sweep found
+  // it, and their patches prefetched, so their memory latency overlaps this pixel's work.
+  int cand[2][32][2];
+  auto draw = [&](int x, int y, int (*out)[2]) {
+    const int32_t* n = L.nnf->at(x, y);
+    CounterRng rng(hash_key(S.C.seed, uint64_t(iter), uint64_t(y) * 65536u + uint64_t(x)));
+    for (int k = 0; k < num_radii; ++k) {
+      const int rad = radii[k];
+      const int wx0 = std::max(lo_x, n[0] - rad), wx1 = std::min(hi_x, n[0] + rad);
+      const int wy0 = std::max(lo_y, n[1] - rad), wy1 = std::min(hi_y, n[1] + rad);
+      out[k][0] = wx0 + int(rng.uniform(uint32_t(wx1 - wx0 + 1)));
+      out[k][1] = wy0 + int(rng.uniform(uint32_t(wy1 - wy0 + 1)));
+      prefetch_candidate(S, band, out[k][0], out[k][1]);
+    }
+  };
   for (int y = ys; y != ye; y += q) {
+    int cur = 0;
+    draw(xs, y, cand[cur]);
     for (int x = xs; x != xe; x += q) {
-      if (!is_active(L, x, y)) continue;
-      int32_t* n = L.nnf->at(x, y);
-      float cur_occ = occupancy(S, band, n[0], n[1]);
-      // Propagation from the neighbours already visited in this sweep's direction.
-      const int nx = x - q;
-      if (nx >= 0 && nx < L.tw && is_active(L, nx, y)) {
-        const int32_t* m = L.nnf->at(nx, y);
-        const int cx = m[0] + q;
-        if (cx >= lo_x && cx <= hi_x) try_candidate(S, band, x, y, cx, m[1], cur_occ);
+      const int next_x = x + q;
+      if (next_x != xe) draw(next_x, y, cand[cur ^ 1]);
+      if (is_active(L, x, y)) {
+        int32_t* n = L.nnf->at(x, y);
+        float cur_occ = occupancy(S, band, n[0], n[1]);
+        // Propagation from the neighbours already visited in this sweep's direction.
+        const int nx = x - q;
+        if (nx >= 0 && nx < L.tw && is_active(L, nx, y)) {
+          const int32_t* m = L.nnf->at(nx, y);
+          const int cx = m[0] + q;
+          if (cx >= lo_x && cx <= hi_x) try_candidate(S, band, x, y, cx, m[1], cur_occ);
+        }
+        const int ny = y - q;
+        if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
+          // Across the band edge, read the field as it was when the sweep began.
+          const bool inside = ny >= y0 && ny < y1;
+          const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, S.snap_slot[ny]);
+          const int cy = m[1] + q;
+          if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy, cur_occ);
+        }
+        for (int k = 0; k < num_radii; ++k)
+          try_candidate(S, band, x, y, cand[cur][k][0], cand[cur][k][1], cur_occ);
       }
-      const int ny = y - q;
-      if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
-        // Across the band edge, read the field as it was when the sweep began.
-        const bool inside = ny >= y0 && ny < y1;
-        const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, S.snap_slot[ny]);
-        const int cy = m[1] + q;
-        if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy, cur_occ);
-      }
-      // Random search in windows halving around the match found so far (drawn all at once so
-      // their patches can be fetched together).
-      CounterRng rng(hash_key(S.C.seed, uint64_t(iter), uint64_t(y) * 65536u + uint64_t(x)));
-      int cand[32][2];
-      const int px = n[0], py = n[1];
-      for (int k = 0; k < num_radii; ++k) {
-        const int rad = radii[k];
-        const int wx0 = std::max(lo_x, px - rad), wx1 = std::min(hi_x, px + rad);
-        const int wy0 = std::max(lo_y, py - rad), wy1 = std::min(hi_y, py + rad);
-        cand[k][0] = wx0 + int(rng.uniform(uint32_t(wx1 - wx0 + 1)));
-        cand[k][1] = wy0 + int(rng.uniform(uint32_t(wy1 - wy0 + 1)));
-        prefetch_candidate(S, band, cand[k][0], cand[k][1]);
-      }
-      for (int k = 0; k < num_radii; ++k) try_candidate(S, band, x, y, cand[k][0], cand[k][1], cur_occ);
+      cur ^= 1;
     }
   }
 }
@@ -245,7 +277,8 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   const double omega_best = double(active_count) / (double(L.sw) * L.sh) * p * p;
   const float occ_scale = C.uniformity > 0.0f ? float(C.uniformity / (double(p) * p * omega_best)) : 0.0f;
 
-  DeltaPool pool(std::size_t(L.sw) * L.sh);
+  const int dirty_stride = (L.sw >> kDirtyShift) + 1;
+  DeltaPool pool(std::size_t(L.sw) * L.sh, std::size_t(dirty_stride) * ((L.sh >> kDirtyShift) + 1));
   // Only the rows on either side of a band edge are read across bands: keep just those.
   const int band = band_rows(L.th);
   std::vector<int> snap_slot(L.th, -1), snap_rows;
@@ -267,12 +300,15 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
     parallel_rows(L.th, band, [&](int y0, int y1) {
       Band band;
       auto buf = pool.take();
-      band.delta = buf.data();
+      band.delta = buf.delta.data();
+      band.dirty = buf.dirty.data();
+      band.dirty_stride = dirty_stride;
       sweep_band(sweep, band, y0, y1, iter);
       // Undo this band's changes so the buffer goes back to the pool zeroed.
       for (std::size_t i = 0; i < band.changes.size(); i += 3)
         add_triangle(band.delta, L.sw, L.sh, band.changes[i], band.changes[i + 1], p,
                      -band.changes[i + 2]);
+      std::fill(buf.dirty.begin(), buf.dirty.end(), uint8_t(0));
       pool.give(std::move(buf));
     });
   }
