@@ -1,0 +1,367 @@
+// End-to-end tests of `emaki run` / `emaki composite` on tiny shots: bad shot files (one-line
+// error naming the key path, non-zero exit, nothing written), re-colouring without synthesis,
+// and resuming a killed run to bit-identical frames.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "core/image.h"
+#include "io/image_io.h"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+using namespace emaki;
+
+namespace {
+
+const std::string kData = EMAKI_SHARED_DATA;
+
+struct RunResult {
+  int exit_code;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// Bit-identical pixels (EXR headers carry a creation date, so files are compared by content).
+bool same_pixels(const fs::path& a, const fs::path& b) {
+  const Image<float> x = io::read_image_float(a.string()), y = io::read_image_float(b.string());
+  if (x.width() != y.width() || x.height() != y.height() || x.channels() != y.channels()) return false;
+  for (int r = 0; r < x.height(); ++r)
+    if (std::memcmp(x.row(r), y.row(r), sizeof(float) * x.width() * x.channels()) != 0) return false;
+  return true;
+}
+
+int count_lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+// The base shot: Fox walking at 64x48, a small copy of the StyLit painting as a MatCap-like
+// exemplar, base + outline layers with temporal on.
+const char* kShot = R"(threads = 2
+[source]
+scene = "@DATA@/scenes/Fox.glb"
+clip = "Walk"
+frames = [0, @LAST@]
+size = [64, 48]
+aa = 1
+[source.camera]
+orbit = 15
+[source.light]
+direction = [0.3, 0.9, -0.3]
+
+[exemplars.sphere]
+painting = "painting.png"
+sphere = [50.7, 41.2, 20.2]
+elevation = 20
+light = [0.3, 0.9, -0.3]
+aa = 1
+
+[layers.base]
+kind = "base"
+exemplar = "sphere"
+patch_size = 5
+@BASE_EXTRA@
+
+[layers.outline]
+kind = "outline"
+exemplar = "sphere"
+
+[compositing]
+paper = "@DATA@/papers/roughpaper.png"
+
+[outputs]
+folder = "out"
+mp4 = false
+contact_sheet = false
+)";
+
+class ShotCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("emaki_shot_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // A 100x76 copy of the StyLit painting (box filter), so exemplar pyramids stay tiny.
+    const Image<float> big = io::read_image_float(kData + "/stylit/source_style.png");
+    const int w = 100, h = 76;
+    Image<float> small(w, h, 3);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const int x0 = x * big.width() / w, x1 = (x + 1) * big.width() / w;
+          const int y0 = y * big.height() / h, y1 = (y + 1) * big.height() / h;
+          double s = 0;
+          for (int yy = y0; yy < y1; ++yy)
+            for (int xx = x0; xx < x1; ++xx) s += big(xx, yy, c);
+          small(x, y, c) = float(s / ((x1 - x0) * (y1 - y0)));
+        }
+    io::WriteOptions wo;
+    wo.format = io::SampleFormat::kU8;
+    io::write_image(p("painting.png"), small.cview(), wo);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string p(const std::string& name) const { return (dir_ / name).string(); }
+
+  std::string shot_text(int last = 2, const std::string& base_extra = "") const {
+    std::string s = kShot;
+    s = std::regex_replace(s, std::regex("@DATA@"), kData);
+    s = std::regex_replace(s, std::regex("@LAST@"), std::to_string(last));
+    s = std::regex_replace(s, std::regex("@BASE_EXTRA@"), base_extra);
+    return s;
+  }
+  void write_shot(const std::string& text, const std::string& name = "shot.toml") const {
+    std::ofstream(p(name)) << text;
+  }
+  RunResult emaki(const std::string& args) const {
+    const std::string err = p("stderr.txt");
+    const std::string cmd = "cd " + dir_.string() + " && " + EMAKI_BINARY + " " + args + " 2>" +
+                            err + " >" + p("stdout.txt");
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+  }
+
+  // Replaces the first occurrence of `from` in the base shot and expects `emaki run` to fail
+  // with one line that names `key` and to leave no output folder.
+  void expect_bad(const std::string& text, const std::string& key) {
+    fs::remove_all(dir_ / "out");
+    write_shot(text);
+    const RunResult r = emaki("run shot.toml");
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(key + ":"), std::string::npos) << "expected key " << key << " in: " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << "output written for: " << r.err;
+  }
+  std::string replaced(const std::string& from, const std::string& to) const {
+    std::string s = shot_text();
+    const std::size_t at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  }
+
+  fs::path dir_;
+};
+
+// ---- bad shot files ----
+
+TEST_F(ShotCli, UnknownKeySuggestsTheClosest) {
+  expect_bad(replaced("patch_size = 5", "patch_sise = 5"), "layers.base.patch_sise");
+  EXPECT_NE(emaki("run shot.toml").err.find("did you mean 'patch_size'"), std::string::npos);
+}
+
+TEST_F(ShotCli, UnknownSectionSuggestsTheClosest) {
+  expect_bad(replaced("[outputs]", "[ouputs]"), "ouputs");
+  EXPECT_NE(emaki("run shot.toml").err.find("did you mean 'outputs'"), std::string::npos);
+}
+
+TEST_F(ShotCli, WrongTypeNamesTheExpectedType) {
+  expect_bad(replaced("patch_size = 5", "patch_size = \"five\""), "layers.base.patch_size");
+  EXPECT_NE(emaki("run shot.toml").err.find("expected an integer, got a string"), std::string::npos);
+}
+
+TEST_F(ShotCli, FramesOfTheWrongType) {
+  expect_bad(replaced("frames = [0, 2]", "frames = \"0-2\""), "source.frames");
+}
+
+TEST_F(ShotCli, MissingExemplarFile) {
+  expect_bad(replaced("painting.png", "no_such_painting.png"), "exemplars.sphere.painting");
+}
+
+TEST_F(ShotCli, EmptyFrameRange) { expect_bad(replaced("frames = [0, 2]", "frames = []"), "source.frames"); }
+
+TEST_F(ShotCli, ReversedFrameRange) {
+  expect_bad(replaced("frames = [0, 2]", "frames = [5, 2]"), "source.frames");
+  EXPECT_NE(emaki("run shot.toml").err.find("reversed"), std::string::npos);
+}
+
+TEST_F(ShotCli, LayerReferringToAnUndefinedExemplar) {
+  expect_bad(replaced("exemplar = \"sphere\"\npatch_size", "exemplar = \"spere\"\npatch_size"),
+             "layers.base.exemplar");
+  EXPECT_NE(emaki("run shot.toml").err.find("did you mean 'sphere'"), std::string::npos);
+}
+
+TEST_F(ShotCli, UnwritableOutputFolder) {
+  expect_bad(replaced("folder = \"out\"", "folder = \"/proc/emaki_out\""), "outputs.folder");
+}
+
+TEST_F(ShotCli, UnknownGuidePass) {
+  expect_bad(shot_text(2, "guides = { normale = 1.0 }"), "layers.base.guides.normale");
+  EXPECT_NE(emaki("run shot.toml").err.find("did you mean 'normal'"), std::string::npos);
+}
+
+TEST_F(ShotCli, UnknownBlendMode) {
+  expect_bad(shot_text(2, "blend = \"multiplly\""), "layers.base.blend");
+  EXPECT_NE(emaki("run shot.toml").err.find("did you mean 'multiply'"), std::string::npos);
+}
+
+TEST_F(ShotCli, EvenPatchSize) { expect_bad(replaced("patch_size = 5", "patch_size = 4"), "layers.base.patch_size"); }
+
+TEST_F(ShotCli, MissingSceneFile) {
+  expect_bad(replaced("scenes/Fox.glb", "scenes/NoFox.glb"), "source.scene");
+}
+
+TEST_F(ShotCli, SyntaxErrorNamesFileLineAndColumn) {
+  expect_bad(replaced("frames = [0, 2]", "frames = [0, "), "shot.toml:6");
+}
+
+TEST_F(ShotCli, ClipNotInTheScene) { expect_bad(replaced("clip = \"Walk\"", "clip = \"Dance\""), "source.clip"); }
+
+TEST_F(ShotCli, FrameRangePastTheClip) {
+  expect_bad(replaced("frames = [0, 2]", "frames = [0, 5000]"), "source.frames");
+}
+
+TEST_F(ShotCli, ColourOutOfRange) { expect_bad(shot_text(2, "color = [2, 0, 0]"), "layers.base.color"); }
+
+TEST_F(ShotCli, SceneAndSequenceTogether) {
+  expect_bad(replaced("clip = \"Walk\"", "sequence = \"r/frame_%04d.exr\""), "source");
+}
+
+TEST_F(ShotCli, MissingOutputsSection) {
+  std::string s = shot_text();
+  s = s.substr(0, s.find("[outputs]"));
+  expect_bad(s, "outputs");
+}
+
+TEST_F(ShotCli, KeyframeExemplarAndItsPassesOfDifferentSizes) {
+  // A 64x48 pass file from `emaki render` next to the 100x76 painting.
+  ASSERT_EQ(emaki("render " + kData + "/scenes/Fox.glb --frames 0-0 --size 64x48 --aa 1 --out renders").exit_code, 0);
+  std::string exr;
+  for (const auto& e : fs::directory_iterator(dir_ / "renders"))
+    if (e.path().extension() == ".exr") exr = e.path().filename().string();
+  ASSERT_FALSE(exr.empty());
+  std::string s = shot_text();
+  const std::size_t a = s.find("[exemplars.sphere]"), b = s.find("[layers.base]");
+  s.replace(a, b - a,
+            "[exemplars.sphere]\nkind = \"keyframe\"\npainting = \"painting.png\"\npasses = \"renders/" +
+                exr + "\"\n\n");
+  expect_bad(s, "exemplars.sphere.passes");
+  EXPECT_NE(emaki("run shot.toml").err.find("64x48"), std::string::npos);
+}
+
+TEST_F(ShotCli, SequencePassChannelNotInTheExr) {
+  ASSERT_EQ(emaki("render " + kData + "/scenes/Fox.glb --frames 0-2 --size 64x48 --aa 1 --out renders").exit_code, 0);
+  std::string exr;
+  for (const auto& e : fs::directory_iterator(dir_ / "renders"))
+    if (e.path().extension() == ".exr") exr = e.path().filename().string();
+  ASSERT_FALSE(exr.empty());
+  // frame_0000.exr -> frame_%04d.exr
+  const std::string pattern = std::regex_replace(exr, std::regex("[0-9]{4}"), "%04d");
+  std::string s = shot_text();
+  const std::size_t a = s.find("scene = "), b = s.find("[exemplars.sphere]");
+  s.replace(a, b - a,
+            "sequence = \"renders/" + pattern +
+                "\"\nframes = [0, 2]\n[source.channels]\nnormal = [\"N.X\", \"N.Y\", \"N.Z\"]\n\n");
+  expect_bad(s, "source.channels.normal");
+}
+
+// ---- re-colouring ----
+
+TEST_F(ShotCli, CompositeRecoloursWithoutSynthesizing) {
+  write_shot(shot_text(1));
+  RunResult r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path layer = dir_ / "out/layers/base/base_0001.exr";
+  const fs::path comp = dir_ / "out/composite/frame_0001.png";
+  ASSERT_TRUE(fs::exists(layer));
+  ASSERT_TRUE(fs::exists(comp));
+  const std::string layer_before = slurp(layer), comp_before = slurp(comp);
+  const auto layer_time = fs::last_write_time(layer);
+
+  write_shot(shot_text(1, "color = [1.0, 0.2, 0.1]\nblend = \"multiply\""));
+  r = emaki("composite shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(layer), layer_before);
+  EXPECT_EQ(fs::last_write_time(layer), layer_time);
+  const std::string comp_after = slurp(comp);
+  EXPECT_NE(comp_after, comp_before);
+  // The new colour shows: where the base layer covers, red now dominates green.
+  const Image<float> before = io::read_image_float(p("out/layers/base/base_0001.exr"));
+  const Image<float> after = io::read_image_float(comp.string());
+  double red = 0, green = 0;
+  for (int y = 0; y < after.height(); ++y)
+    for (int x = 0; x < after.width(); ++x)
+      if (before(x, y, 1) > 0.5f) red += after(x, y, 0), green += after(x, y, 1);
+  EXPECT_GT(red, 1.5 * green);
+  // And a second `emaki run` finds everything finished: nothing is synthesized.
+  r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(" 0 layer-frames synthesized"), std::string::npos) << r.err;
+}
+
+// ---- resume ----
+
+TEST_F(ShotCli, KilledRunResumesToBitIdenticalFrames) {
+  const int last = 7;
+  write_shot(shot_text(last));
+  // Uninterrupted, into out_ref.
+  {
+    std::string s = shot_text(last);
+    s.replace(s.find("folder = \"out\""), 14, "folder = \"out_ref\"");
+    write_shot(s, "ref.toml");
+  }
+  RunResult r = emaki("run ref.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  // Killed once frame 2 of the base layer is finished.
+  pid_t pid = 0;
+  std::vector<std::string> args = {EMAKI_BINARY, "run", p("shot.toml")};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  ASSERT_EQ(posix_spawn(&pid, EMAKI_BINARY, &fa, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&fa);
+  const fs::path marker = dir_ / "out/layers/base/base_0002.exr";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(marker) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run finished before it could be killed";
+  ASSERT_FALSE(fs::exists(dir_ / "out/composite" / "frame_0007.png"));
+
+  r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find(" 0 layer-frames synthesized"), std::string::npos) << r.err;
+  for (int f = 0; f <= last; ++f) {
+    char name[64];
+    std::snprintf(name, sizeof name, "composite/frame_%04d.png", f);
+    EXPECT_TRUE(same_pixels(dir_ / "out" / name, dir_ / "out_ref" / name)) << name;
+    for (const char* layer : {"base", "outline"}) {
+      std::snprintf(name, sizeof name, "layers/%s/%s_%04d.exr", layer, layer, f);
+      EXPECT_TRUE(same_pixels(dir_ / "out" / name, dir_ / "out_ref" / name)) << name;
+    }
+  }
+  // No temporary file is left behind.
+  for (const auto& e : fs::recursive_directory_iterator(dir_ / "out"))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+}  // namespace
