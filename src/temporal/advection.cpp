@@ -23,9 +23,11 @@ Image<float> advect(const AdvectionInputs& in, const synth::Params& params) {
   synth::Inputs inputs;
   inputs.style = style.cview();
   inputs.style_name = "previous frame";
-  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, 1.0f});
+  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, in.guide_weight});
   if (in.current_mask) inputs.target_mask = *in.current_mask;
-  synth::Result r = synth::synthesize(inputs, params);
+  synth::Params p = params;
+  p.uniformity = 0.0f;
+  synth::Result r = synth::synthesize(inputs, p);
   if (r.image.channels() == n) return std::move(r.image);
   // Drop the alpha the mask added; outside the mask the value is the empty value.
   Image<float> out(r.image.width(), r.image.height(), n);

@@ -1,0 +1,75 @@
+#include "temporal/advection.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace emaki::temporal {
+namespace {
+
+// A guide whose every pixel is distinct: its normalised coordinates shifted by `dx` pixels.
+Image<float> position_guide(int w, int h, float dx) {
+  Image<float> g(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      g(x, y, 0) = (x + dx) / w;
+      g(x, y, 1) = float(y) / h;
+      g(x, y, 2) = 0.5f;
+    }
+  return g;
+}
+
+Image<float> stripes(int w, int h, float dx) {
+  Image<float> s(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) s(x, y) = 0.5f + 0.5f * std::sin(0.7f * (x + dx) + 0.3f * y);
+  return s;
+}
+
+double mean_abs_diff(const Image<float>& a, const Image<float>& b, int margin) {
+  double s = 0;
+  int n = 0;
+  for (int y = margin; y < a.height() - margin; ++y)
+    for (int x = margin; x < a.width() - margin; ++x) s += std::abs(a(x, y) - b(x, y)), ++n;
+  return s / n;
+}
+
+// The surface moved 4 pixels to the left between t-1 and t: the advected frame is the previous
+// stylized frame moved with it, and much closer to that than to the unmoved previous frame.
+TEST(Advection, CarriesThePreviousFrameAlongThePositionGuide) {
+  const int w = 64, h = 48;
+  const Image<float> prev = stripes(w, h, 0.0f);
+  const Image<float> g_prev = position_guide(w, h, 0.0f), g_cur = position_guide(w, h, 4.0f);
+  AdvectionInputs in;
+  in.previous_stylized = prev.cview();
+  in.previous_guide = g_prev.cview();
+  in.current_guide = g_cur.cview();
+  synth::Params p;
+  p.patch_size = 5;
+  const Image<float> adv = advect(in, p);
+  ASSERT_EQ(adv.channels(), 1);
+  const Image<float> expected = stripes(w, h, 4.0f);
+  const double moved = mean_abs_diff(adv, expected, 6);
+  const double unmoved = mean_abs_diff(adv, prev, 6);
+  EXPECT_LT(moved, 0.06);
+  EXPECT_LT(moved, 0.3 * unmoved);
+}
+
+// Outside its mask the previous frame had nothing; the advection reads the empty value there.
+TEST(Advection, MaskedPreviousFrameUsesTheEmptyValue) {
+  const int w = 48, h = 32;
+  Image<float> prev(w, h, 2);  // value 0.2 everywhere, coverage 0: nothing was synthesized
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) prev(x, y, 0) = 0.2f;
+  const Image<float> g = position_guide(w, h, 0.0f);
+  AdvectionInputs in;
+  in.previous_stylized = prev.cview();
+  in.previous_guide = g.cview();
+  in.current_guide = g.cview();
+  in.empty_value = 0.9f;
+  const Image<float> adv = advect(in, synth::Params{});
+  EXPECT_NEAR(adv(w / 2, h / 2), 0.9f, 1e-4f);
+}
+
+}  // namespace
+}  // namespace emaki::temporal
