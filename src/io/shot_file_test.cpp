@@ -1,0 +1,88 @@
+#include "io/shot_file.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/error.h"
+
+namespace emaki::io {
+namespace {
+
+const std::string kData = EMAKI_SHARED_DATA;
+
+std::string minimal(const std::string& layers) {
+  return "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nframes = [0, 3]\nsize = [64, 48]\n" +
+         "[exemplars.sphere]\npainting = \"" + kData + "/stylit/source_style.png\"\n" + layers +
+         "[outputs]\nfolder = \"/tmp/emaki_shot_file_test_out\"\n";
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_shot(text, "/tmp/shot.toml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ShotFile, EditDistance) {
+  EXPECT_EQ(edit_distance("weight", "wieght"), 2);
+  EXPECT_EQ(edit_distance("", "abc"), 3);
+  EXPECT_EQ(edit_distance("kitten", "sitting"), 3);
+  EXPECT_EQ(closest_key("wieght", {"weight", "width"}), "weight");
+  EXPECT_EQ(closest_key("banana", {"weight", "width"}), "");
+}
+
+TEST(ShotFile, KindsSetTheirDefaults) {
+  const pipeline::Shot s = parse_shot(
+      minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n"
+              "[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\n"
+              "[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"),
+      "/tmp/shot.toml");
+  ASSERT_EQ(s.layers.size(), 3u);
+  // File order is kept (toml++ sorts keys; the parser orders by line).
+  EXPECT_EQ(s.layers[0].name, "base");
+  EXPECT_EQ(s.layers[1].name, "ink");
+  EXPECT_EQ(s.layers[2].name, "dark");
+  EXPECT_EQ(s.layers[0].look.source, composite::ColorSource::kAlbedo);
+  EXPECT_EQ(s.layers[0].mask.kind, pipeline::MaskKind::kCovered);
+  EXPECT_EQ(s.layers[1].mask.kind, pipeline::MaskKind::kLines);
+  EXPECT_EQ(s.layers[1].look.alpha_from, composite::AlphaFrom::kInverseValue);
+  EXPECT_FLOAT_EQ(s.layers[1].temporal.weight, 0.5f);
+  EXPECT_EQ(s.layers[2].look.blend, composite::BlendMode::kMultiply);
+  EXPECT_EQ(s.layers[2].guides[1].pass, "shadow");
+  EXPECT_TRUE(s.layers[0].single_colour);
+  EXPECT_EQ(s.layers[0].temporal.guide, pipeline::AdvectionGuide::kRestPosition);
+  EXPECT_EQ(s.source.width, 64);
+  EXPECT_EQ(s.source.shot.last_frame, 3);
+}
+
+TEST(ShotFile, GuidesKeepTheFileOrderAndOrderSortsLayers) {
+  const pipeline::Shot s = parse_shot(
+      minimal("[layers.top]\nexemplar = \"sphere\"\norder = 2\nguides = { shadow = 0.5, normal = 2 }\n"
+              "[layers.bottom]\nexemplar = \"sphere\"\norder = 1\nguides = { diffuse = 1 }\n"
+              "gradient = [[0, 0, 0, 0], [1, 1, 0.5, 0]]\n"),
+      "/tmp/shot.toml");
+  EXPECT_EQ(s.layers[0].name, "bottom");
+  EXPECT_EQ(s.layers[1].guides[0].pass, "shadow");
+  EXPECT_FLOAT_EQ(s.layers[1].guides[1].weight, 2.0f);
+  EXPECT_EQ(s.layers[0].look.source, composite::ColorSource::kGradient);
+  EXPECT_FLOAT_EQ(s.layers[0].look.gradient[1].color.g, 0.5f);
+}
+
+TEST(ShotFile, ErrorsNameTheKeyPath) {
+  const std::string base = "[layers.outline]\nkind = \"outline\"\nexemplar = \"sphere\"\n";
+  EXPECT_EQ(error_of(minimal(base + "wieght = 1\n")).rfind("layers.outline.wieght: unknown key", 0), 0u);
+  EXPECT_NE(error_of(minimal(base + "temporal_wieght = 1\n")).find("did you mean 'temporal_weight'"),
+            std::string::npos);
+  EXPECT_EQ(error_of(minimal(base + "opacity = 2\n")).rfind("layers.outline.opacity: must be in [0, 1]", 0), 0u);
+  EXPECT_EQ(error_of(minimal(base + "levels = [0.5, 0.2, 1]\n")).rfind("layers.outline.levels:", 0), 0u);
+  EXPECT_EQ(error_of(minimal(base + "guides = { motion = 1 }\n")).rfind("layers.outline.guides.motion:", 0), 0u);
+  EXPECT_EQ(error_of(minimal(base + "gradient = [[0.5, 0, 0, 0], [0.1, 1, 1, 1]]\n")).rfind("layers.outline.gradient:", 0), 0u);
+  EXPECT_EQ(error_of(minimal("[layers.a]\nexemplar = \"sphere\"\n")).rfind("layers.a.guides: is required", 0), 0u);
+  EXPECT_EQ(error_of(minimal("[layers.\"bad name\"]\nkind = \"base\"\nexemplar = \"sphere\"\n")).rfind("layers.bad name:", 0), 0u);
+}
+
+}  // namespace
+}  // namespace emaki::io

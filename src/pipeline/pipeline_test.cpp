@@ -1,0 +1,212 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "core/error.h"
+#include "pipeline/flicker.h"
+#include "pipeline/frames.h"
+#include "pipeline/run.h"
+#include "render/passes.h"
+
+namespace emaki::pipeline {
+namespace {
+
+// Synthetic passes: a covered frame whose normal and diffuse vary smoothly, a line down the
+// middle, the whole picture sliding right by one pixel a frame (motion says so).
+class SlidingFrames : public FrameSource {
+ public:
+  SlidingFrames(int w, int h) : w_(w), h_(h) {}
+  Image<float> passes(int frame) const override {
+    ++calls;
+    Image<float> p(w_, h_, render::kChannelCount);
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x) {
+        float* o = p.at(x, y);
+        const float u = float(x - frame) / w_, v = float(y) / h_;
+        o[render::kNormal] = u;
+        o[render::kNormal + 1] = v;
+        o[render::kNormal + 2] = 0.5f;
+        for (int c = 0; c < 3; ++c) o[render::kPositionNorm + c] = o[render::kRestPosition + c] = c == 0 ? u : c == 1 ? v : 0.5f;
+        o[render::kDiffuse] = 0.5f + 0.5f * std::sin(6.0f * u);
+        o[render::kAlbedo] = o[render::kAlbedo + 1] = o[render::kAlbedo + 2] = 0.5f;
+        o[render::kObjectId] = 2.0f;
+        o[render::kAlpha] = 1.0f;
+        o[render::kOutline] = x - frame == w_ / 2 ? 1.0f : 0.0f;
+        o[render::kMotion] = -1.0f;  // the previous frame had this point one pixel to the left
+      }
+    return p;
+  }
+  mutable int calls = 0;
+
+ private:
+  int w_, h_;
+};
+
+class MemoryStore : public Store {
+ public:
+  bool has_layer(const Layer& l, int f) const override { return layers.count({l.name, f}) > 0; }
+  Image<float> read_layer(const Layer& l, int f) const override {
+    ++reads;
+    return layers.at({l.name, f}).clone();
+  }
+  void write_layer(const Layer& l, int f, ImageView<const float> v) override {
+    Image<float> img(v.width, v.height, v.channels);
+    for (int y = 0; y < v.height; ++y) std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
+    layers[{l.name, f}] = std::move(img);
+  }
+  bool has_frame(int f) const override { return frames.count(f) > 0; }
+  void write_frame(int f, ImageView<const float> c, const std::vector<ImageView<const float>>&,
+                   ImageView<const float>) override {
+    frames[f] = c(c.width / 2, c.height / 2, 0);
+  }
+  std::map<std::pair<std::string, int>, Image<float>> layers;
+  std::map<int, float> frames;
+  mutable int reads = 0;
+};
+
+Shot tiny_shot() {
+  Shot s;
+  s.source.first_frame = 0;
+  s.source.last_frame = 3;
+  s.source.width = 40;
+  s.source.height = 30;
+  Exemplar e;
+  e.name = "ex";
+  s.exemplars.push_back(e);
+  Layer l;
+  l.name = "base";
+  l.exemplar = "ex";
+  l.guides = {{"normal", 1.0f}, {"diffuse", 1.0f}};
+  l.synth.patch_size = 3;
+  s.layers.push_back(l);
+  return s;
+}
+
+std::map<std::string, ExemplarImages> tiny_exemplar() {
+  const SlidingFrames f(36, 28);
+  ExemplarImages ex;
+  ex.passes = f.passes(0);
+  ex.painting = Image<float>(36, 28, 3);
+  for (int y = 0; y < 28; ++y)
+    for (int x = 0; x < 36; ++x)
+      for (int c = 0; c < 3; ++c) ex.painting(x, y, c) = 0.5f + 0.4f * std::sin(0.9f * x + 0.4f * y + c);
+  std::map<std::string, ExemplarImages> m;
+  m.emplace("ex", std::move(ex));
+  return m;
+}
+
+TEST(Pipeline, LineMaskIsDilated) {
+  const SlidingFrames f(40, 30);
+  const Image<float> p = f.passes(0);
+  const Image<float> m = layer_mask(p.cview(), {MaskKind::kLines, 2.0f, 0.5f});
+  EXPECT_EQ(m(20, 10), 1.0f);
+  EXPECT_EQ(m(22, 10), 1.0f);
+  EXPECT_EQ(m(23, 10), 0.0f);
+  EXPECT_TRUE(layer_mask(p.cview(), {MaskKind::kNone, 0.0f, 0.5f}).empty());
+}
+
+TEST(Pipeline, FlickerFollowsMotion) {
+  const SlidingFrames f(40, 30);
+  const Image<float> p0 = f.passes(0), p1 = f.passes(1);
+  // A value glued to the surface (a function of u) does not flicker when followed by motion.
+  Image<float> v0(40, 30, 1), v1(40, 30, 1), still(40, 30, 1);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x) {
+      v0(x, y) = p0(x, y, render::kNormal);
+      v1(x, y) = p1(x, y, render::kNormal);
+      still(x, y) = 0.3f;
+    }
+  const FrameFlicker glued = frame_flicker(v1.cview(), v0.cview(), p1.cview(), p0.cview(), -1);
+  EXPECT_GT(glued.objects.pixels, 800);
+  EXPECT_NEAR(glued.objects.mean(), 0.0, 1e-6);
+  // The same value not moving with the surface does flicker: one pixel's worth of u.
+  const FrameFlicker slid = frame_flicker(v0.cview(), v0.cview(), p1.cview(), p0.cview(), -1);
+  EXPECT_NEAR(slid.objects.mean(), 1.0 / 40, 1e-4);
+  EXPECT_EQ(glued.ground.pixels, 0);
+}
+
+TEST(Pipeline, RunsResumesAndContinuesTheChain) {
+  const Shot shot = tiny_shot();
+  const SlidingFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  MemoryStore full;
+  RunOptions o;
+  RunReport r = run_shot(shot, frames, ex, CompositeInputs{}, full, o);
+  EXPECT_EQ(r.synthesized, 4);
+  EXPECT_EQ(r.composited, 4);
+
+  // Only frames 0-1 finished: resuming synthesizes 2-3 from frame 1, read back once.
+  MemoryStore part;
+  o.last_frame = 1;
+  run_shot(shot, frames, ex, CompositeInputs{}, part, o);
+  o.last_frame = -1;
+  part.reads = 0;
+  r = run_shot(shot, frames, ex, CompositeInputs{}, part, o);
+  EXPECT_EQ(r.synthesized, 2);
+  EXPECT_EQ(r.reused, 2);
+  EXPECT_EQ(part.reads, 1);
+  for (int f = 0; f <= 3; ++f) {
+    const Image<float>& a = full.layers.at({"base", f});
+    const Image<float>& b = part.layers.at({"base", f});
+    ASSERT_EQ(a.bytes(), b.bytes());
+    EXPECT_EQ(std::memcmp(a.row(0), b.row(0), a.bytes()), 0) << "frame " << f;
+  }
+
+  // --frames 3-3 on a fresh store starts the chain at the first frame.
+  MemoryStore fresh;
+  o.first_frame = 3;
+  o.last_frame = 3;
+  r = run_shot(shot, frames, ex, CompositeInputs{}, fresh, o);
+  EXPECT_EQ(r.first_frame, 0);
+  EXPECT_EQ(r.synthesized, 4);
+  EXPECT_EQ(r.composited, 1);
+}
+
+TEST(Pipeline, TemporalGuideChangesFramesAfterTheFirst) {
+  Shot shot = tiny_shot();
+  const SlidingFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  MemoryStore with, without;
+  run_shot(shot, frames, ex, CompositeInputs{}, with, RunOptions{});
+  shot.layers[0].temporal.enabled = false;
+  run_shot(shot, frames, ex, CompositeInputs{}, without, RunOptions{});
+  const auto same = [&](int f) {
+    const Image<float>& a = with.layers.at({"base", f});
+    const Image<float>& b = without.layers.at({"base", f});
+    return std::memcmp(a.row(0), b.row(0), a.bytes()) == 0;
+  };
+  EXPECT_TRUE(same(0));   // the first frame has no temporal guide
+  EXPECT_FALSE(same(2));
+}
+
+TEST(Pipeline, UnknownLayerOptionIsAnError) {
+  const Shot shot = tiny_shot();
+  const SlidingFrames frames(40, 30);
+  MemoryStore store;
+  RunOptions o;
+  o.layers = {"bsae"};
+  try {
+    run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, store, o);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.subject(), "--layers");
+  }
+}
+
+TEST(Pipeline, ContactSheetGrid) {
+  std::vector<Image<float>> frames;
+  for (int i = 0; i < 5; ++i) {
+    frames.emplace_back(100, 50, 3);
+    frames.back().fill(0.1f * i);
+  }
+  const Image<float> sheet = contact_sheet(frames, 4, 40);
+  EXPECT_EQ(sheet.width(), 4 * 40 + 5 * 4);
+  EXPECT_EQ(sheet.height(), 2 * 20 + 3 * 4);
+  EXPECT_FLOAT_EQ(sheet(4 + 40 + 4 + 10, 4 + 10, 0), 0.1f);  // second thumbnail
+  EXPECT_FLOAT_EQ(sheet(4 + 10, 4 + 20 + 4 + 10, 0), 0.4f);   // fifth, second row
+}
+
+}  // namespace
+}  // namespace emaki::pipeline
