@@ -12,7 +12,7 @@ label() {  # label IN OUT TEXT
   oiiotool "$1" --text:x=6:y=18:size=15:color=1,0.75,0:font="$FONT" "$3" -o "$2"
 }
 
-"$EMAKI" render examples/data/Fox.glb --clip Walk --frames 8 --size 300x169 --azimuth 50 \
+"$EMAKI" render examples/data/Fox.glb --clip Walk --frames 8 --size 300x169 --azimuth=-50 \
   --elevation 12 --out "$TMP/fox" --previews --quiet
 tiles=""
 for p in normal position_norm rest_position depth diffuse shadow albedo object_id material_id \

@@ -420,6 +420,17 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
     const scene::PosedScene posed = scene::pose_scene(scene, animation_, time_of(f));
     shot_bounds_.add(scene::world_bounds(posed));
     if (f == shot_.first_frame) rest_box_ = cube_around(scene::rest_bounds(posed));
+    // A few poses' vertices (first, middle, last frame; at most ~20k points) for framing.
+    const int mid = (shot_.first_frame + shot_.last_frame) / 2;
+    if (f == shot_.first_frame || f == mid || f == shot_.last_frame) {
+      std::size_t total = 0;
+      for (const auto& p : posed.primitives) total += p.world_positions.size();
+      const std::size_t step = std::max<std::size_t>(1, total / 20000);
+      std::size_t i = 0;
+      for (const auto& p : posed.primitives)
+        for (const glm::vec3& v : p.world_positions)
+          if (i++ % step == 0) fit_points_.push_back(v);
+    }
   }
   position_box_ = cube_around(shot_bounds_);
   // Just under the lowest point, so an object's flat bottom does not z-fight with the ground.
@@ -441,7 +452,7 @@ scene::ViewCamera ShotRenderer::camera(float frame) const {
     const float start = animation_ >= 0 ? scene_.animations[animation_].start : 0.0f;
     pose = scene::evaluate_pose(scene_, animation_, start + frame / shot_.fps);
   }
-  return scene::camera_at(shot_, scene_, pose, shot_bounds_, frame, aspect);
+  return scene::camera_at(shot_, scene_, pose, shot_bounds_, frame, aspect, &fit_points_);
 }
 
 Image<float> ShotRenderer::render(int frame) const {

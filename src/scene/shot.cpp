@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace emaki::scene {
@@ -24,7 +25,8 @@ glm::mat4 look_at(const glm::vec3& eye, const glm::vec3& target) {
 }  // namespace
 
 ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
-                     const Bounds& bounds, float frame, float aspect) {
+                     const Bounds& bounds, float frame, float aspect,
+                     const std::vector<glm::vec3>* fit_points) {
   const CameraSpec& spec = shot.camera;
   ViewCamera cam;
   cam.shift = spec.shift;
@@ -57,16 +59,22 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
     const glm::vec3 dir(std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el));
     float dist = spec.distance;
     if (dist <= 0.0f && !bounds.empty()) {
-      // The nearest distance at which all eight corners of the bounds fall inside 90 % of the
-      // frame (per corner: depth = dist - z must make |x| / depth and |y| / depth small enough).
+      // The nearest distance at which every fit point (or the bounds' eight corners) falls inside
+      // 90 % of the frame: a point at depth dist - z needs |x| / depth and |y| / depth small.
       const glm::vec3 back = dir;
       const glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
       const glm::vec3 up = glm::cross(back, right);
       const float m = 0.9f;
+      std::vector<glm::vec3> corners;
+      if (!fit_points || fit_points->empty()) {
+        for (int k = 0; k < 8; ++k)
+          corners.emplace_back((k & 1) ? bounds.hi.x : bounds.lo.x,
+                               (k & 2) ? bounds.hi.y : bounds.lo.y,
+                               (k & 4) ? bounds.hi.z : bounds.lo.z);
+      }
+      const std::vector<glm::vec3>& points = corners.empty() ? *fit_points : corners;
       dist = 0.0f;
-      for (int k = 0; k < 8; ++k) {
-        const glm::vec3 c((k & 1) ? bounds.hi.x : bounds.lo.x, (k & 2) ? bounds.hi.y : bounds.lo.y,
-                          (k & 4) ? bounds.hi.z : bounds.lo.z);
+      for (const glm::vec3& c : points) {
         const glm::vec3 d = c - target;
         const float z = glm::dot(d, back);
         float need;

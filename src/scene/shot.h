@@ -5,6 +5,7 @@
 
 #include <glm/glm.hpp>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 
@@ -76,8 +77,11 @@ struct ViewCamera {
 
 // The camera at `frame` (fractional frames allowed). `bounds` are the shot's world bounds
 // (union over the frame range); `pose` is the scene's pose at that frame (for glTF cameras).
+// The automatic camera's distance frames `fit_points` (e.g. the objects' vertices over the shot)
+// when given, else the corners of `bounds`.
 ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
-                     const Bounds& bounds, float frame, float aspect);
+                     const Bounds& bounds, float frame, float aspect,
+                     const std::vector<glm::vec3>* fit_points = nullptr);
 
 // The key light direction (unit, towards the light) in world space for the whole shot.
 glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera);
