@@ -298,30 +298,63 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
     const float t = (ta.view_d - glm::dot(ta.view_normal, o)) / denom;
     return std::abs(t - depth_b) / std::max(depth_b, 1e-12f);
   };
-  auto edge = [&](int ax, int ay, int bx, int by) -> bool {
+  // 0: no line between the two samples, 1: silhouette / depth jump / id boundary, 2: crease.
+  auto edge = [&](int ax, int ay, int bx, int by) -> uint8_t {
     const std::size_t ia = vb.index(ax, ay), ib = vb.index(bx, by);
     const int32_t a = vb.tri[ia], b = vb.tri[ib];
-    if (a == b) return false;
+    if (a == b) return 0;
     const int oa = a < 0 ? 0 : tris[a].object_id, ob = b < 0 ? 0 : tris[b].object_id;
     // The ground's far edge against the background is not a line anyone wants.
-    if ((oa == 0 && ob == kGroundObject) || (ob == 0 && oa == kGroundObject)) return false;
-    if (a < 0 || b < 0) return true;
-    if (oa != ob || tris[a].material_id != tris[b].material_id) return true;
+    if ((oa == 0 && ob == kGroundObject) || (ob == 0 && oa == kGroundObject)) return 0;
+    if (a < 0 || b < 0) return 1;
+    if (oa != ob || tris[a].material_id != tris[b].material_id) return 1;
     const float da = proj.depth_from_key(vb.key[ia]), db = proj.depth_from_key(vb.key[ib]);
     const float err = std::min(plane_error(tris[a], bx, by, db), plane_error(tris[b], ax, ay, da));
-    if (err > jump) return true;
-    return glm::dot(tris[a].face_normal, tris[b].face_normal) < cos_crease;
+    if (err > jump) return 1;
+    return glm::dot(tris[a].face_normal, tris[b].face_normal) < cos_crease ? 2 : 0;
   };
-  // Each sample records its edges to the right and below; a sample is on a line when any of its
-  // four neighbours differs (both sides are marked, so lines centre on the boundary).
+  // Each sample records its edges to the right (bits 0-1) and below (bits 2-3); a sample is on a
+  // line when it differs from any of its four neighbours (both sides are marked, so lines centre
+  // on the boundary).
   std::vector<uint8_t> bits(std::size_t(W) * H, 0);
   parallel_rows(H, 16, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < W; ++x) {
         uint8_t b = 0;
-        if (x + 1 < W && edge(x, y, x + 1, y)) b |= 1;
-        if (y + 1 < H && edge(x, y, x, y + 1)) b |= 2;
+        if (x + 1 < W) b |= edge(x, y, x + 1, y);
+        if (y + 1 < H) b |= edge(x, y, x, y + 1) << 2;
         bits[vb.index(x, y)] = b;
+      }
+  });
+  // mark: 1 on a silhouette / id line, 2 on a crease only.
+  std::vector<uint8_t> mark(std::size_t(W) * H, 0);
+  parallel_rows(H, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < W; ++x) {
+        const std::size_t i = vb.index(x, y);
+        const uint8_t b = (bits[i] & 3) | (bits[i] >> 2) | (x > 0 ? bits[i - 1] & 3 : 0) |
+                          (y > 0 ? bits[i - W] >> 2 : 0);
+        mark[i] = (b & 1) ? 1 : (b & 2) ? 2 : 0;
+      }
+  });
+  // A crease mark with almost no marked samples around it is where a few faces meet at a
+  // vertex, not a crease line: it would print as a speck, so it is dropped.
+  std::vector<uint8_t> keep(std::size_t(W) * H, 0);
+  parallel_rows(H, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < W; ++x) {
+        const std::size_t i = vb.index(x, y);
+        if (mark[i] != 2) {
+          keep[i] = mark[i];
+          continue;
+        }
+        int around = 0;
+        for (int dy = -3; dy <= 3; ++dy)
+          for (int dx = -3; dx <= 3; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < W && yy < H && mark[vb.index(xx, yy)]) ++around;
+          }
+        keep[i] = around >= 8 ? 2 : 0;
       }
   });
   const float half_width = 0.5f * opt.outline_width * S;  // in samples
@@ -332,10 +365,7 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
   parallel_rows(H, 16, [&](int y0, int y1) {
     std::vector<uint8_t> marked(W);
     for (int y = y0; y < y1; ++y) {
-      for (int x = 0; x < W; ++x) {
-        const std::size_t i = vb.index(x, y);
-        marked[x] = bits[i] || (x > 0 && (bits[i - 1] & 1)) || (y > 0 && (bits[i - W] & 2));
-      }
+      for (int x = 0; x < W; ++x) marked[x] = keep[vb.index(x, y)] != 0;
       float* row = hdist.data() + std::size_t(y) * W;
       float d = far;
       for (int x = 0; x < W; ++x) row[x] = d = marked[x] ? 0.0f : std::min(far, d + 1.0f);
