@@ -67,14 +67,14 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-// Reads one table, remembering which keys were read, so that finish() can report the others
-// as unknown with the closest known key.
+// Reads one table against the list of keys it may hold; a key not in that list is an error with
+// the closest known key as a suggestion.
 class Reader {
  public:
   // Unknown keys are reported first: a typo explains the errors that would follow from it.
   Reader(const toml::table& table, std::string path, std::vector<std::string> known)
       : table_(table), path_(std::move(path)), known_(std::move(known)) {
-    finish();
+    check_unknown_keys();
   }
 
   std::string key_path(std::string_view key) const {
@@ -183,8 +183,8 @@ class Reader {
     return t;
   }
 
-  // Every key of the table that was not read is an error.
-  void finish() const {
+  // Every key of the table that emaki does not know is an error.
+  void check_unknown_keys() const {
     for (const auto& [k, v] : table_) {
       const std::string key(k.str());
       if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
@@ -275,7 +275,6 @@ void parse_camera(Reader& r, scene::CameraSpec& c) {
   c.orbit_deg = r.real("orbit", c.orbit_deg);
   c.dolly = r.real("dolly", c.dolly, 0.01, 100.0);
   c.pan = r.vec3("pan", c.pan);
-  r.finish();
 }
 
 void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
@@ -338,7 +337,6 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
         throw Error(l.key_path("direction"), "must not be [0, 0, 0]");
       s.shot.light.camera_relative = !l.boolean("world", false);
       s.shot.light.softness_deg = l.real("softness", s.shot.light.softness_deg, 0.0, 45.0);
-      l.finish();
     }
     if (const toml::table* t = r.table("ground")) {
       Reader g(*t, r.key_path("ground"), {"enabled", "size", "height", "color"});
@@ -347,7 +345,6 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       if (g.has("height")) s.shot.ground.height = g.real("height", 0.0f), s.shot.ground.auto_height = false;
       const composite::Color c = g.color("color", {0.8f, 0.8f, 0.8f});
       s.shot.ground.color = {c.r, c.g, c.b};
-      g.finish();
     }
     if (r.has("channels")) throw Error(r.key_path("channels"), "applies to a 'sequence' source only");
   } else {
@@ -378,7 +375,6 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
           throw Error(m.key_path(pass), fmt::format("expected {}, got {}", expected, cm.channels.size()));
         s.channels.push_back(cm);
       }
-      m.finish();
     }
     // The first frame must exist and carry every pass the pipeline may read.
     const std::string first = frame_file(s.pattern, s.first_frame);
@@ -400,7 +396,6 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     s.width = probe.width();
     s.height = probe.height();
   }
-  r.finish();
 }
 
 // ---- exemplars ----
@@ -435,7 +430,6 @@ void parse_exemplar(Reader& r, Context& ctx, pipeline::Exemplar& e) {
       if (r.has(k)) throw Error(r.key_path(k), "applies to a 'matcap' exemplar only");
     e.passes = ctx.input_file(r, "passes", true);
   }
-  r.finish();
 }
 
 // ---- layers ----
@@ -499,7 +493,6 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
     std::vector<std::pair<std::string, int>> order;
     for (const auto& [k, v] : *t) order.emplace_back(std::string(k.str()), int(v.source().begin.line) * 10000 + int(v.source().begin.column));
     std::stable_sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.second < b.second; });
-    g.finish();
     for (const auto& [pass, line] : order) {
       if (pass == "motion" || pass == "alpha" || pass == "position" || pass == "depth")
         throw Error(g.key_path(pass), "this pass does not mean the same on the exemplar and the shot; "
@@ -610,7 +603,6 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
   f.hue_deg = r.real("hue", 0.0f, -360.0, 360.0);
   f.saturation = r.real("saturation", 1.0f, 0.0, 10.0);
   f.opacity = r.real("opacity", 1.0f, 0.0, 1.0);
-  r.finish();
 }
 
 void check_output_folder(const std::string& key, const std::string& folder) {
@@ -707,7 +699,6 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     shot.compositing.paper = ctx.input_file(r, "paper", false);
     shot.compositing.paper_scale = r.real("paper_scale", 1.0f, 0.01, 100.0);
     shot.compositing.paper_color = r.color("paper_color", shot.compositing.paper_color);
-    r.finish();
   }
 
   {
@@ -726,12 +717,10 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     o.mp4 = r.boolean("mp4", o.mp4);
     o.contact_sheet = r.boolean("contact_sheet", o.contact_sheet);
     o.crf = r.integer("crf", o.crf, 0, 51);
-    r.finish();
     if (o.mp4 && !o.composite_png)
       throw Error("outputs.mp4", "is made from the composited PNG frames: needs composite_png = true");
     check_output_folder("outputs.folder", o.folder);
   }
-  top.finish();
   return shot;
 }
 
