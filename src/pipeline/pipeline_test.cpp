@@ -181,6 +181,21 @@ TEST(Pipeline, TemporalGuideChangesFramesAfterTheFirst) {
   EXPECT_FALSE(same(2));
 }
 
+TEST(Pipeline, ColourLayerTransfersRgbWithItsMask) {
+  Shot shot = tiny_shot();
+  shot.layers[0].single_colour = false;
+  shot.layers[0].mask = {MaskKind::kLines, 3.0f, 0.5f};
+  const SlidingFrames frames(40, 30);
+  MemoryStore store;
+  const RunReport r = run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, store, RunOptions{});
+  EXPECT_EQ(r.synthesized, 4);
+  const Image<float>& v = store.layers.at({"base", 2});
+  ASSERT_EQ(v.channels(), 4);  // RGB + mask coverage
+  EXPECT_EQ(v(21, 10, 3), 1.0f);  // the line sits at x = 20 + 2 in frame 2
+  EXPECT_EQ(v(5, 10, 3), 0.0f);
+  EXPECT_NE(v(21, 10, 0), v(21, 10, 2));  // colours, not one touch
+}
+
 TEST(Pipeline, UnknownLayerOptionIsAnError) {
   const Shot shot = tiny_shot();
   const SlidingFrames frames(40, 30);
