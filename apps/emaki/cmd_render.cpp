@@ -72,15 +72,20 @@ int run_render(const Args& args) {
       "DIR/frame_NNNN.exr, channels as in docs/passes.md.",
       "emaki render"};
   std::string scene_path, frames = "0", out_dir, clip;
-  float fps = 24.0f;
+  float fps = 24.0f, start_time = 0.0f;
   bool previews = false, full_float = false, quiet = false;
   ShotOptions so;
   app.add_option("scene", scene_path, "the scene, .gltf or .glb")->required();
-  app.add_option("--frames", frames,
-                 "frame range A-B (or one frame A), A >= 0; frame f is at clip start + f / fps")
+  app.add_option(
+         "--frames", frames,
+         "frame range A-B (or one frame A), A >= 0; frame f is at clip start + --start + f / fps")
       ->capture_default_str();
   app.add_option("--out", out_dir, "output folder (created if missing)")->required();
   app.add_option("--clip", clip, "animation clip by name; default: the first clip");
+  app.add_option("--start", start_time,
+                 "seconds into the clip of frame 0, >= 0 (and within the clip)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--fps", fps, "frames per second, > 0")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -96,6 +101,7 @@ int run_render(const Args& args) {
   so.resolve(shot, options);
   parse_frames(frames, shot.first_frame, shot.last_frame);
   shot.fps = fps;
+  shot.start_time = start_time;
   shot.clip = clip;
 
   const scene::Scene scene = io::load_gltf(scene_path);

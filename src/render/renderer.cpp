@@ -433,12 +433,16 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
   if (animation_ >= 0) {
     const scene::Animation& a = scene.animations[animation_];
     const float duration = a.end - a.start;
-    const int last_frame = int(std::floor(duration * shot_.fps + 1e-3f));
+    if (shot_.start_time < 0.0f || shot_.start_time > duration)
+      throw Error("--start", fmt::format("{} s is outside clip '{}' ({:.3f} s long)",
+                                         shot_.start_time, a.name, duration));
+    const int last_frame = int(std::floor((duration - shot_.start_time) * shot_.fps + 1e-3f));
     if (shot_.last_frame > last_frame)
-      throw Error("--frames", fmt::format("frame {} is at {:.3f} s, past the end of clip '{}' "
-                                          "({:.3f} s long: frames 0-{} at {} fps)",
-                                          shot_.last_frame, shot_.last_frame / shot_.fps, a.name,
-                                          duration, last_frame, shot_.fps));
+      throw Error("--frames",
+                  fmt::format("frame {} is at {:.3f} s, past the end of clip '{}' "
+                              "({:.3f} s long: frames 0-{} at {} fps from {} s)",
+                              shot_.last_frame, shot_.start_time + shot_.last_frame / shot_.fps,
+                              a.name, duration, last_frame, shot_.fps, shot_.start_time));
   }
   if (shot_.camera.mode == scene::CameraSpec::Mode::kGltf) {
     const int n = shot_.camera.gltf_node;
@@ -472,7 +476,7 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
 
 float ShotRenderer::time_of(int frame) const {
   const float start = animation_ >= 0 ? scene_.animations[animation_].start : 0.0f;
-  return start + float(frame) / shot_.fps;
+  return start + shot_.start_time + float(frame) / shot_.fps;
 }
 
 scene::ViewCamera ShotRenderer::camera(float frame) const {
@@ -480,7 +484,7 @@ scene::ViewCamera ShotRenderer::camera(float frame) const {
   scene::Pose pose;
   if (shot_.camera.mode == scene::CameraSpec::Mode::kGltf) {
     const float start = animation_ >= 0 ? scene_.animations[animation_].start : 0.0f;
-    pose = scene::evaluate_pose(scene_, animation_, start + frame / shot_.fps);
+    pose = scene::evaluate_pose(scene_, animation_, start + shot_.start_time + frame / shot_.fps);
   }
   return scene::camera_at(shot_, scene_, pose, shot_bounds_, frame, aspect, &fit_points_);
 }

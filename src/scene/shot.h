@@ -60,7 +60,8 @@ struct ShotSpec {
   glm::vec3 background{0.0f};
   std::string clip;  // animation name; empty = the first clip, if any
   float fps = 24.0f;
-  int first_frame = 0;  // frame f is at time clip.start + f / fps
+  float start_time = 0.0f;  // seconds into the clip of frame 0, [0, clip length]
+  int first_frame = 0;      // frame f is at time clip.start + start_time + f / fps
   int last_frame = 0;
 };
 
