@@ -209,6 +209,17 @@ class ShadowMap {
     ro.with_attributes = false;
     map_.reset(size, size, false);
     rasterize(verts, idx, ro, map_);
+    // Nearest occluder per block of texels: most receivers see no occluder anywhere near and are
+    // answered from a few blocks instead of a full blocker search.
+    blocks_ = (size + kBlock - 1) / kBlock;
+    block_min_.assign(std::size_t(blocks_) * blocks_, std::numeric_limits<float>::infinity());
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const float key = map_.key[map_.index(x, y)];
+        if (std::isinf(key)) continue;
+        float& m = block_min_[std::size_t(y / kBlock) * blocks_ + x / kBlock];
+        m = std::min(m, -key);
+      }
   }
 
   // 1 = fully lit by the key light, 0 = fully in its cast shadow. The depth bias grows with the
@@ -230,6 +241,7 @@ class ShadowMap {
     // radius away), then a filter as wide as the penumbra at this receiver.
     const float search = std::clamp(tan_half_ * radius_ / texel_, 1.0f, 32.0f);
     const float d_search = biased(search);
+    if (nearest_in(u - search, v - search, u + search, v + search) >= d_search) return 1.0f;
     float blockers = 0.0f;
     int n = 0;
     for (int j = -2; j <= 2; ++j)
@@ -258,7 +270,23 @@ class ShadowMap {
   }
 
   Projector proj_;
+  // The nearest occluder depth over the blocks touching a map rectangle.
+  float nearest_in(float u0, float v0, float u1, float v1) const {
+    const int bx0 = std::clamp(int(std::floor(u0)) / kBlock, 0, blocks_ - 1);
+    const int by0 = std::clamp(int(std::floor(v0)) / kBlock, 0, blocks_ - 1);
+    const int bx1 = std::clamp(int(std::floor(u1)) / kBlock, 0, blocks_ - 1);
+    const int by1 = std::clamp(int(std::floor(v1)) / kBlock, 0, blocks_ - 1);
+    float m = std::numeric_limits<float>::infinity();
+    for (int by = by0; by <= by1; ++by)
+      for (int bx = bx0; bx <= bx1; ++bx)
+        m = std::min(m, block_min_[std::size_t(by) * blocks_ + bx]);
+    return m;
+  }
+
+  static constexpr int kBlock = 16;
   VisibilityBuffer map_;
+  std::vector<float> block_min_;
+  int blocks_ = 0;
   int size_ = 0;
   float radius_ = 1.0f, texel_ = 1.0f, tan_half_ = 0.0f;
 };
