@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <cstdio>
@@ -288,6 +289,12 @@ TEST_F(ShotCli, CompositeRecoloursWithoutSynthesizing) {
   const fs::path comp = dir_ / "out/composite/frame_0001.png";
   ASSERT_TRUE(fs::exists(layer));
   ASSERT_TRUE(fs::exists(comp));
+  // The layered EXR holds every pass and every layer under distinct names.
+  const std::vector<std::string> ch = io::list_channels(p("out/layered/frame_0001.exr"));
+  for (const char* name : {"normal.X", "outline.Y", "layer_base.Y", "layer_base.A", "layer_outline.Y",
+                           "composite.R"})
+    EXPECT_NE(std::find(ch.begin(), ch.end(), name), ch.end()) << name;
+  EXPECT_EQ(ch.size(), 24u + 2 + 2 + 3);
   const std::string layer_before = slurp(layer), comp_before = slurp(comp);
   const auto layer_time = fs::last_write_time(layer);
 

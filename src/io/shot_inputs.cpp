@@ -265,7 +265,8 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
     std::vector<std::string> names = render::channel_names();
     int channels = passes.channels + 3;
     for (std::size_t i = 0; i < layers.size(); ++i) {
-      const auto n = value_names(shot_.layers[i].name + ".", layers[i].channels,
+      // Prefixed: a layer may share its name with a pass ("shadow", "outline").
+      const auto n = value_names("layer_" + shot_.layers[i].name + ".", layers[i].channels,
                                  shot_.layers[i].single_colour ? 1 : 3);
       names.insert(names.end(), n.begin(), n.end());
       channels += layers[i].channels;
