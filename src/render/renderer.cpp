@@ -402,12 +402,25 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
         row[x] = std::min(row[x], d = marked[x] ? 0.0f : std::min(far, d + 1.0f));
     }
   });
+  // Which (sample row, pixel column) spans hold any sample near a line: most pixels have none in
+  // their vertical window and are skipped.
+  const int Wp = frame.width(), Hp = frame.height();
+  std::vector<uint8_t> near(std::size_t(H) * Wp, 0);
+  parallel_rows(H, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int px = 0; px < Wp; ++px)
+        for (int sx = px * S; sx < (px + 1) * S; ++sx)
+          if (hdist[std::size_t(y) * W + sx] < far) near[std::size_t(y) * Wp + px] = 1;
+  });
   // Vertical combination gives the exact Euclidean distance within `reach`; a sample's coverage
   // is how much of it a line of the given width centred on the boundary covers.
-  const int Wp = frame.width(), Hp = frame.height();
   parallel_rows(Hp, 8, [&](int py0, int py1) {
     for (int py = py0; py < py1; ++py)
       for (int px = 0; px < Wp; ++px) {
+        bool any = false;
+        for (int yy = std::max(0, py * S - reach); yy < std::min(H, (py + 1) * S + reach); ++yy)
+          any = any || near[std::size_t(yy) * Wp + px];
+        if (!any) continue;
         float sum = 0.0f;
         for (int sy = py * S; sy < (py + 1) * S; ++sy)
           for (int sx = px * S; sx < (px + 1) * S; ++sx) {
