@@ -279,6 +279,35 @@ TEST_F(ShotCli, SequencePassChannelNotInTheExr) {
   expect_bad(s, "source.channels.normal");
 }
 
+TEST_F(ShotCli, SequenceSourceAndKeyframeExemplarRun) {
+  ASSERT_EQ(emaki("render " + kData + "/scenes/Fox.glb --clip Walk --frames 0-2 --size 64x48 --aa 1 --out renders").exit_code, 0);
+  std::string exr;
+  for (const auto& e : fs::directory_iterator(dir_ / "renders"))
+    if (e.path().extension() == ".exr" && e.path().filename().string().find("0000") != std::string::npos)
+      exr = e.path().filename().string();
+  ASSERT_FALSE(exr.empty());
+  const std::string pattern = std::regex_replace(exr, std::regex("[0-9]{4}"), "%04d");
+  // A 64x48 "painted keyframe": the painting squeezed to the frame's size.
+  const Image<float> painting = io::read_image_float(p("painting.png"));
+  Image<float> key(64, 48, 3);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) key(x, y, c) = painting(x * 100 / 64, y * 76 / 48, c);
+  io::write_image(p("key.png"), key.cview());
+  std::string s = shot_text();
+  const std::size_t a = s.find("scene = "), b = s.find("[layers.base]");
+  s.replace(a, b - a,
+            "sequence = \"renders/" + pattern + "\"\nframes = [0, 2]\n\n[exemplars.sphere]\n"
+            "kind = \"keyframe\"\npainting = \"key.png\"\npasses = \"renders/" + exr + "\"\n\n");
+  write_shot(s);
+  const RunResult r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out/composite/frame_0002.png"));
+  const Image<float> base = io::read_image_float(p("out/layers/base/base_0002.exr"));
+  EXPECT_EQ(base.width(), 64);
+  EXPECT_EQ(base.height(), 48);
+}
+
 // ---- re-colouring ----
 
 TEST_F(ShotCli, CompositeRecoloursWithoutSynthesizing) {
