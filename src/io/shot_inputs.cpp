@@ -105,7 +105,9 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
   try {
     return pipeline::scene_frames(std::move(scene), s);
   } catch (const Error& e) {
-    rethrow_as_key(e, e.subject() == "--clip" ? "source.clip" : "source.frames");
+    rethrow_as_key(e, e.subject() == "--clip"    ? "source.clip"
+                      : e.subject() == "--start" ? "source.start"
+                                                 : "source.frames");
   }
 }
 
