@@ -575,8 +575,8 @@ Scene load_gltf(const std::string& path) {
   for (const std::string& ext_name : model.extensionsRequired) {
     if (ext_name != "KHR_mesh_quantization" && ext_name != "KHR_materials_unlit" &&
         ext_name != "KHR_texture_transform" && ext_name.rfind("KHR_materials_", 0) != 0)
-      throw Error(path, fmt::format("requires the glTF extension {}, which is not supported",
-                                    ext_name));
+      throw Error(path,
+                  fmt::format("requires the glTF extension {}, which is not supported", ext_name));
   }
   return Loader(path, model).load();
 }

@@ -49,9 +49,9 @@ class ShotRenderer {
   scene::ShotSpec shot_;
   RenderOptions options_;
   int animation_ = -1;
-  scene::Bounds shot_bounds_;   // world bounds of the objects over the frame range
-  scene::Bounds position_box_;  // cube around shot_bounds_
-  scene::Bounds rest_box_;      // cube around the rest-pose bounds
+  scene::Bounds shot_bounds_;          // world bounds of the objects over the frame range
+  scene::Bounds position_box_;         // cube around shot_bounds_
+  scene::Bounds rest_box_;             // cube around the rest-pose bounds
   std::vector<glm::vec3> fit_points_;  // vertices over the shot, framed by the automatic camera
   float ground_height_ = 0.0f;
   glm::vec3 light_{0, 1, 0};

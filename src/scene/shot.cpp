@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 #include <glm/gtc/matrix_transform.hpp>
+#include <vector>
 
 namespace emaki::scene {
 
