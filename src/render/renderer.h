@@ -28,20 +28,23 @@ struct RenderOptions {
 // other frame's.
 class ShotRenderer {
  public:
-  // Throws emaki::Error for a clip that is not in the scene ("--clip") or a frame range that
-  // leaves the clip ("--frames").
+  // Throws emaki::Error for a clip that is not in the scene ("--clip"), a start time or frame
+  // range that leaves the clip ("--start", "--frames"), a node that is not a camera
+  // ("--gltf-camera") or more samples than the sample buffers allow ("--aa"). `scene` must
+  // outlive the renderer.
   ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& shot,
                const RenderOptions& options);
 
   // The kChannelCount-channel frame (see passes.h).
   Image<float> render(int frame) const;
 
-  // The clip time of a frame: clip start + frame / fps.
+  // The clip time of a frame: clip start + start_time + frame / fps.
   float time_of(int frame) const;
   int animation() const { return animation_; }
   const scene::Bounds& position_box() const { return position_box_; }
   const scene::Bounds& rest_box() const { return rest_box_; }
   const glm::vec3& light() const { return light_; }
+  // The camera at a frame (fractional frames allowed; motion uses frame - 1).
   scene::ViewCamera camera(float frame) const;
 
  private:
