@@ -114,6 +114,15 @@ TEST_F(SynthCli, SameOutputForOneAndTwoThreadsAndExtrasWritten) {
   EXPECT_EQ(io::read_image(p("err.exr")).channels(), 1);
 }
 
+TEST_F(SynthCli, GrayGuideBesideColourGuide) {
+  // src.png is one channel, tgt2.png three: the gray side is spread over RGB (EbSynth reads
+  // every file as RGBA, so such pairs work there too).
+  const RunResult r = run("-style " + p("style.png") + " -guide " + p("src.png") + " " +
+                          p("tgt2.png") + " -output " + p("o.png"));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(p("o.png")));
+}
+
 TEST_F(SynthCli, MaskGivesAlpha) {
   Image<float> m(56, 44, 1);
   for (int y = 10; y < 30; ++y)

@@ -107,13 +107,29 @@ int effective_channels(const io::AnyImage& im) {
   return nc;
 }
 
+// Gives an image `channels` channels: keeps the first ones (effective_channels only drops
+// trailing ones), or spreads a gray image over RGB when its partner guide is in colour.
 io::AnyImage reduce(io::AnyImage im, int channels) {
-  if (im.channels() == channels) return im;
-  if (channels == 2 && im.channels() == 4) {  // gray + alpha from RGBA
-    io::AnyImage out = im.select_channels(0, 4);
-    return out;
-  }
-  return im.select_channels(0, channels);
+  const int have = im.channels();
+  if (have == channels) return im;
+  if (have > channels) return im.select_channels(0, channels);
+  io::AnyImage out;
+  std::visit(
+      [&](const auto& src) {
+        using T = std::decay_t<decltype(src(0, 0))>;
+        Image<T> o(src.width(), src.height(), channels);
+        const bool gray = have <= 2;
+        for (int y = 0; y < src.height(); ++y)
+          for (int x = 0; x < src.width(); ++x)
+            for (int c = 0; c < channels; ++c) {
+              int from = std::min(c, have - 1);
+              if (gray) from = c < 3 ? 0 : have - 1;
+              o(x, y, c) = src(x, y, from);
+            }
+        out.image = std::move(o);
+      },
+      im.image);
+  return out;
 }
 
 synth::Plane plane_of(const io::AnyImage& im) {
