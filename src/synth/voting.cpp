@@ -1,5 +1,6 @@
 #include "synth/voting.h"
 
+#include <algorithm>
 #include <type_traits>
 #include <vector>
 
@@ -8,11 +9,48 @@
 namespace emaki::synth {
 
 namespace {
+// Integer samples are summed as they are and scaled once at the end.
 template <typename T>
-inline float norm(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>) return float(v) * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>) return float(v) * (1.0f / 65535.0f);
-  else return float(v);
+constexpr double sample_scale() {
+  if constexpr (std::is_same_v<T, uint8_t>) return 1.0 / 255.0;
+  else if constexpr (std::is_same_v<T, uint16_t>) return 1.0 / 65535.0;
+  else return 1.0;
+}
+
+template <int NC, typename T>
+void vote_rows(ImageView<const T> source, const Image<int32_t>& nnf, const Image<float>& weight,
+               const Image<uint8_t>& active, int r, Image<float>& out, int y0, int y1) {
+  const int tw = nnf.width(), th = nnf.height();
+  const bool all = active.empty();
+  constexpr double scale = sample_scale<T>();
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < tw; ++x) {
+      float* o = out.at(x, y);
+      if (!all && !active(x, y)) {
+        for (int c = 0; c < NC; ++c) o[c] = 0.0f;
+        continue;
+      }
+      // Double sums: where every patch agrees the vote returns exactly the source value, so an
+      // exact match stays exact after re-quantisation.
+      double acc[NC] = {};
+      double wsum = 0.0;
+      const int uy0 = std::max(0, y - r), uy1 = std::min(th - 1, y + r);
+      const int ux0 = std::max(0, x - r), ux1 = std::min(tw - 1, x + r);
+      for (int uy = uy0; uy <= uy1; ++uy) {
+        const int32_t* m = nnf.at(ux0, uy);
+        const float* wrow = weight.row(uy);
+        for (int ux = ux0; ux <= ux1; ++ux, m += 2) {
+          if (!all && !active(ux, uy)) continue;
+          const T* s = source.at(m[0] - (ux - x), m[1] - (uy - y));
+          const double w = wrow[ux];
+          for (int c = 0; c < NC; ++c) acc[c] += w * double(s[c]);
+          wsum += w;
+        }
+      }
+      // The pixel's own patch always counts: wsum > 0.
+      const double inv = scale / wsum;
+      for (int c = 0; c < NC; ++c) o[c] = float(acc[c] * inv);
+    }
 }
 
 template <typename T>
@@ -21,38 +59,22 @@ void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image
   const int tw = nnf.width(), th = nnf.height(), nc = source.channels;
   const int r = patch_size / 2;
   if (out.width() != tw || out.height() != th || out.channels() != nc) out.reset(tw, th, nc);
-  const bool all = active.empty();
-  // EbSynth's weighting: error per patch pixel and channel.
+  // Each patch's weight once, not once per pixel it covers. EbSynth's weighting: error per patch
+  // pixel and channel.
+  Image<float> weight(tw, th, 1);
   const float err_norm = 1.0f / float(patch_size * patch_size * nc);
-  parallel_rows(th, 16, [&](int y0, int y1) {
-    // Double sums: where every patch agrees the vote returns exactly the source value, so an
-    // exact match stays exact after re-quantisation.
-    std::vector<double> acc(nc);
+  parallel_rows(th, 64, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < tw; ++x) {
-        float* o = out.at(x, y);
-        if (!all && !active(x, y)) {
-          for (int c = 0; c < nc; ++c) o[c] = 0.0f;
-          continue;
-        }
-        std::fill(acc.begin(), acc.end(), 0.0);
-        double wsum = 0.0;
-        for (int oy = -r; oy <= r; ++oy) {
-          const int uy = y + oy;
-          if (uy < 0 || uy >= th) continue;
-          for (int ox = -r; ox <= r; ++ox) {
-            const int ux = x + ox;
-            if (ux < 0 || ux >= tw || (!all && !active(ux, uy))) continue;
-            const int32_t* m = nnf.at(ux, uy);
-            const T* s = source.at(m[0] - ox, m[1] - oy);
-            const float w = mode == VoteMode::kPlain ? 1.0f : 1.0f / (1.0f + err(ux, uy) * err_norm);
-            for (int c = 0; c < nc; ++c) acc[c] += double(w) * norm(s[c]);
-            wsum += w;
-          }
-        }
-        // The pixel's own patch always counts: wsum > 0.
-        for (int c = 0; c < nc; ++c) o[c] = float(acc[c] / wsum);
-      }
+      for (int x = 0; x < tw; ++x)
+        weight(x, y) = mode == VoteMode::kPlain ? 1.0f : 1.0f / (1.0f + err(x, y) * err_norm);
+  });
+  parallel_rows(th, 16, [&](int y0, int y1) {
+    switch (nc) {
+      case 1: vote_rows<1>(source, nnf, weight, active, r, out, y0, y1); break;
+      case 2: vote_rows<2>(source, nnf, weight, active, r, out, y0, y1); break;
+      case 3: vote_rows<3>(source, nnf, weight, active, r, out, y0, y1); break;
+      default: vote_rows<4>(source, nnf, weight, active, r, out, y0, y1); break;
+    }
   });
 }
 
