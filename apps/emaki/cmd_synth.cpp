@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fmt/format.h>
 #include <optional>
@@ -249,7 +250,24 @@ int run_synth(const Args& args) {
   set_thread_count(threads);
 
   const auto t0 = std::chrono::steady_clock::now();
-  io::AnyImage style = io::read_image(style_path);
+  // Decode every file at once (PNG decoding is serial per file); report the first failure in
+  // command-line order so the error does not depend on timing.
+  std::vector<std::string> paths{style_path};
+  for (const auto& g : guides) paths.insert(paths.end(), {g.source, g.target});
+  std::vector<io::AnyImage> files(paths.size());
+  std::vector<std::exception_ptr> failures(paths.size());
+  parallel_for(int64_t(paths.size()), 1, [&](int64_t a, int64_t b) {
+    for (int64_t i = a; i < b; ++i) {
+      try {
+        files[i] = io::read_image(paths[i]);
+      } catch (...) {
+        failures[i] = std::current_exception();
+      }
+    }
+  });
+  for (const auto& f : failures)
+    if (f) std::rethrow_exception(f);
+  io::AnyImage style = std::move(files[0]);
   style = reduce(std::move(style), effective_channels(style));
   if (style.channels() > 4) throw Error(style_path, "style must have 1 to 4 channels");
 
@@ -258,9 +276,10 @@ int run_synth(const Args& args) {
   synth::Inputs in;
   in.style = plane_of(style);
   in.style_name = style_path;
-  for (const auto& g : guides) {
-    io::AnyImage s = io::read_image(g.source);
-    io::AnyImage t = io::read_image(g.target);
+  for (std::size_t k = 0; k < guides.size(); ++k) {
+    const GuideArg& g = guides[k];
+    io::AnyImage s = std::move(files[1 + 2 * k]);
+    io::AnyImage t = std::move(files[2 + 2 * k]);
     if (s.width() != style.width() || s.height() != style.height())
       throw Error(g.source, fmt::format("source guide is {}x{} but the style '{}' is {}x{}",
                                         s.width(), s.height(), style_path, style.width(),

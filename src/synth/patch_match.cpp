@@ -73,6 +73,7 @@ struct Sweep {
   int r;
   std::ptrdiff_t src_stride, tgt_stride;
   int row_elems;
+  double inv_err_scale;
 };
 
 // Occupancy deltas are tracked per 8x8 block of source centres: most candidates land in blocks
@@ -129,7 +130,7 @@ inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int 
   const float cur_cost = e + cur_occ;
   const float bound = cur_cost - new_occ;
   if (!(bound > 0.0f)) return;
-  const double bq = std::floor(double(bound) / S.C.err_scale);
+  const double bq = std::floor(double(bound) * S.inv_err_scale);
   const int64_t bound_q = bq > 9.0e18 ? std::numeric_limits<int64_t>::max() : int64_t(bq);
   const int16_t* t = L.tgt->at(x + L.border - S.r, y + L.border - S.r);
   const int16_t* s = L.src->at(cx - S.r, cy - S.r);
@@ -296,7 +297,7 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
     if (occ_scale > 0.0f) occupancy_window_sums(L, p, occ, occ_scratch);
     else occ.assign(std::size_t(L.sw) * L.sh, 0);
     const Sweep sweep{L, C, occ.data(), snap, snap_slot, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
-                      p * L.src->channels()};
+                      p * L.src->channels(), 1.0 / C.err_scale};
     parallel_rows(L.th, band, [&](int y0, int y1) {
       Band band;
       auto buf = pool.take();
