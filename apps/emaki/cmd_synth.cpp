@@ -35,7 +35,7 @@ EbSynth options (single dash)
   -patchsize N          patch size, odd, >= 3. Default: 5
   -pyramidlevels N      pyramid levels, >= 1. Default: as many as fit
   -searchvoteiters N    search-vote iterations per level, >= 0. Default: emaki's schedule
-                        (6 at coarse levels; 4, 2, 2 at the three finest)
+                        (6 at coarse levels; 3, 2, 2 at the three finest)
   -patchmatchiters N    PatchMatch iterations per search-vote iteration, >= 0. Default: emaki's
                         schedule (4 at coarse levels; 3, 3, 2 at the three finest)
   -stopthreshold N      accepted for compatibility; no effect (as in EbSynth's CPU backend)

@@ -165,13 +165,13 @@ std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
   // from a field that is already good, so they refine it with fewer iterations, the two finest
   // with a bounded search radius. Measured with the judge at full size on StyLit and FaceStyle
   // (see README): style, joint and coverage hold against EbSynth's 6 x 4 at every level, with
-  // about 1/6 of the candidate evaluations. (One search-vote iteration at the finest level was
+  // about 1/7 of the candidate evaluations. (One search-vote iteration at the finest level was
   // enough for StyLit but not for FaceStyle's joint energy.)
   for (int l = 0; l < levels; ++l) {
     const int from_finest = levels - 1 - l;
-    if (from_finest == 0) s[l] = {2, 2, 64};
-    else if (from_finest == 1) s[l] = {2, 3, 64};
-    else if (from_finest == 2) s[l] = {4, 3, 0};
+    if (from_finest == 0) s[l] = {2, 2, 32};
+    else if (from_finest == 1) s[l] = {2, 3, 32};
+    else if (from_finest == 2) s[l] = {3, 3, 0};
     else s[l] = {6, 4, 0};
   }
   return s;
