@@ -1,11 +1,14 @@
 #!/bin/sh
-# One command: install the Debian packages, build, and run the bundled example: the StyLit
-# painting (a pastel sphere) carried onto a target figure through four light-path guides,
-# EbSynth's own example command line, run by `emaki synth`. Output: out/stylit.png
+# One command: install the Debian packages, build, and run the bundled examples:
+#  1. the shot examples/fox/shot.toml (Fox walking, three stylized layers, temporal advection,
+#     composited over paper) -> examples/fox/out/ (frames, layered EXRs, preview.mp4)
+#  2. EbSynth's StyLit example command line through `emaki synth` -> out/stylit.png
 set -e
 cd "$(dirname "$0")"
 ./scripts/setup.sh
 ./scripts/build.sh
+./build/release/apps/emaki/emaki run examples/fox/shot.toml
+echo "wrote examples/fox/out/ (preview.mp4, contact_sheet.png, layers/, composite/, layered/)"
 mkdir -p out
 E=examples/stylit
 ./build/release/apps/emaki/emaki synth -style $E/source_style.png \

@@ -15,7 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kEmaki = EMAKI_BINARY;
-const std::string kScenes = std::string(EMAKI_SHARED_DATA) + "/scenes/";
+const std::string kScenes = std::string(EMAKI_TEST_DATA) + "/scenes/";
 
 struct Outcome {
   int exit_code;
@@ -189,7 +189,7 @@ TEST_F(RenderCli, TemplateWritesPassesAndPaintTemplate) {
 }
 
 TEST_F(RenderCli, TemplateFitNeedsTheSphere) {
-  expect_failure("template --fit " + std::string(EMAKI_SHARED_DATA) +
+  expect_failure("template --fit " + std::string(EMAKI_TEST_DATA) +
                      "/stylit/source_style.png --out " + out(),
                  "--sphere", "required");
 }

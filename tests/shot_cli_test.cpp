@@ -29,7 +29,7 @@ using namespace emaki;
 
 namespace {
 
-const std::string kData = EMAKI_SHARED_DATA;
+const std::string kData = EMAKI_TEST_DATA;
 
 struct RunResult {
   int exit_code;

@@ -9,7 +9,7 @@
 namespace emaki::io {
 namespace {
 
-const std::string kData = EMAKI_SHARED_DATA;
+const std::string kData = EMAKI_TEST_DATA;
 
 std::string minimal(const std::string& layers) {
   return "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nframes = [0, 3]\nsize = [64, 48]\n" +

@@ -17,7 +17,7 @@
 namespace emaki::render {
 namespace {
 
-const std::string kScenes = std::string(EMAKI_SHARED_DATA) + "/scenes/";
+const std::string kScenes = std::string(EMAKI_TEST_DATA) + "/scenes/";
 
 // Bilinear sample of channels [first, first + 3) at pixel coordinates (x right, y down, centres
 // at +0.5); false where any of the four pixels is not fully covered, has another object id or

@@ -12,7 +12,7 @@
 namespace emaki::scene {
 namespace {
 
-const std::string kScenes = std::string(EMAKI_SHARED_DATA) + "/scenes/";
+const std::string kScenes = std::string(EMAKI_TEST_DATA) + "/scenes/";
 constexpr float kPi = 3.14159265358979f;
 
 void expect_near(const glm::vec3& a, const glm::vec3& b, float tol = 1e-4f) {
