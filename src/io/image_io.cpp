@@ -82,6 +82,14 @@ AnyImage AnyImage::select_channels(int first, int count) const {
 
 namespace detail {
 
+// OpenImageIO's OpenEXR plugin resizes OpenEXR's global thread pool on every open, which races
+// when two threads open files at once (ThreadSanitizer shows it); calls into the plugin are
+// therefore taken one at a time. PNG, the common case, stays parallel.
+std::mutex& oiio_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 const OiioBackend& oiio_backend(const std::string& subject) {
   static const OiioBackend* backend = nullptr;
   static std::string failure;
@@ -153,6 +161,7 @@ std::vector<std::string> list_channels(const std::string& path) {
   check_readable(path);
   if (is_png(path)) return detail::read_png(path).channel_names;
   std::vector<std::string> names;
+  std::lock_guard lock(detail::oiio_mutex());
   if (std::string e = detail::oiio_backend(path).list_channels(path, names); !e.empty())
     throw Error(path, e);
   return names;
@@ -187,6 +196,7 @@ AnyImage read_image(const std::string& path, const ReadOptions& options) {
     }
     return result;
   }
+  std::lock_guard lock(detail::oiio_mutex());
   if (std::string e = detail::oiio_backend(path).read(path, options, result); !e.empty())
     throw Error(path, e);
   return result;
@@ -250,10 +260,12 @@ void write_image(const std::string& path, ImageView<const float> image,
   try {
     if (ext == ".png") {
       detail::write_png(tmp.string(), image, type == 1, path);
-    } else if (std::string e = detail::oiio_backend(path).write(tmp.string(), image,
-                                                                 options.channel_names, type);
-               !e.empty()) {
-      throw Error(path, e);
+    } else {
+      std::lock_guard lock(detail::oiio_mutex());
+      if (std::string e = detail::oiio_backend(path).write(tmp.string(), image,
+                                                           options.channel_names, type);
+          !e.empty())
+        throw Error(path, e);
     }
   } catch (...) {
     fs::remove(tmp, ec);
