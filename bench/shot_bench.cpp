@@ -23,11 +23,16 @@ using namespace emaki;
 
 class MemoryStore : public pipeline::Store {
  public:
-  bool has_layer(const pipeline::Layer& l, int f) const override { return layers_.count({l.name, f}) > 0; }
-  Image<float> read_layer(const pipeline::Layer& l, int f) const override { return layers_.at({l.name, f}).clone(); }
+  bool has_layer(const pipeline::Layer& l, int f) const override {
+    return layers_.count({l.name, f}) > 0;
+  }
+  Image<float> read_layer(const pipeline::Layer& l, int f) const override {
+    return layers_.at({l.name, f}).clone();
+  }
   void write_layer(const pipeline::Layer& l, int f, ImageView<const float> v) override {
     Image<float> img(v.width, v.height, v.channels);
-    for (int y = 0; y < v.height; ++y) std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
+    for (int y = 0; y < v.height; ++y)
+      std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
     layers_[{l.name, f}] = std::move(img);
   }
   bool has_frame(int) const override { return false; }
@@ -74,10 +79,11 @@ int main(int argc, char** argv) {
     pipeline::run_shot(shot, *source, exemplars, ci, store, o);
     double later = 0;
     for (std::size_t i = 1; i < seconds.size(); ++i) later += seconds[i];
-    std::printf("shot_bench: %dx%d, %zu layers, %d threads: frame 0 (no temporal) %.2f s; "
-                "frames 1-%d (temporal) %.2f s per frame\n",
-                width, height, shot.layers.size(), thread_count(), seconds[0], frames - 1,
-                later / double(seconds.size() - 1));
+    std::printf(
+        "shot_bench: %dx%d, %zu layers, %d threads: frame 0 (no temporal) %.2f s; "
+        "frames 1-%d (temporal) %.2f s per frame\n",
+        width, height, shot.layers.size(), thread_count(), seconds[0], frames - 1,
+        later / double(seconds.size() - 1));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shot_bench: %s\n", e.what());
     return 1;

@@ -22,9 +22,12 @@ int main(int argc, char** argv) {
   int repeat = 3, threads = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--repeat") repeat = std::max(1, std::atoi(argv[i + 1]));
-    else if (a == "--threads") threads = std::atoi(argv[i + 1]);
-    else if (a == "--data") dir = argv[i + 1];
+    if (a == "--repeat")
+      repeat = std::max(1, std::atoi(argv[i + 1]));
+    else if (a == "--threads")
+      threads = std::atoi(argv[i + 1]);
+    else if (a == "--data")
+      dir = argv[i + 1];
   }
   set_thread_count(threads);
   const char* names[] = {"fullgi", "dirdif", "dirspc", "indirb"};
@@ -34,8 +37,10 @@ int main(int argc, char** argv) {
     src.push_back(io::read_image_float(dir + "/source_" + std::string(n) + ".png"));
     tgt.push_back(io::read_image_float(dir + "/target_" + std::string(n) + ".png"));
   }
-  std::printf("synth_bench: StyLit, 3 style channels + 4 RGB guides, default settings, %d threads, best of %d\n",
-              thread_count(), repeat);
+  std::printf(
+      "synth_bench: StyLit, 3 style channels + 4 RGB guides, default settings, %d threads, best of "
+      "%d\n",
+      thread_count(), repeat);
   std::printf("%10s %10s %12s %14s\n", "size", "pixels", "seconds", "ns/pixel");
   std::vector<double> per_pixel;
   // Smallest first: 1/4, 1/2, full size, each halving low-passed.
@@ -56,7 +61,8 @@ int main(int argc, char** argv) {
     for (int r = 0; r < repeat; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
       synth::Result res = synth::synthesize(in, synth::Params());
-      const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double sec =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       best = std::min(best, sec);
     }
     const double px = double(g[0].second.width()) * g[0].second.height();

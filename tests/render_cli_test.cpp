@@ -189,9 +189,9 @@ TEST_F(RenderCli, TemplateWritesPassesAndPaintTemplate) {
 }
 
 TEST_F(RenderCli, TemplateFitNeedsTheSphere) {
-  expect_failure("template --fit " + std::string(EMAKI_TEST_DATA) +
-                     "/stylit/source_style.png --out " + out(),
-                 "--sphere", "required");
+  expect_failure(
+      "template --fit " + std::string(EMAKI_TEST_DATA) + "/stylit/source_style.png --out " + out(),
+      "--sphere", "required");
 }
 
 }  // namespace

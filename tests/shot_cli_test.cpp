@@ -1,8 +1,8 @@
 // End-to-end tests of `emaki run` / `emaki composite` on tiny shots: bad shot files (one-line
 // error naming the key path, non-zero exit, nothing written), re-colouring without synthesis,
 // and resuming a killed run to bit-identical frames.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -46,9 +46,11 @@ std::string slurp(const fs::path& p) {
 // Bit-identical pixels (EXR headers carry a creation date, so files are compared by content).
 bool same_pixels(const fs::path& a, const fs::path& b) {
   const Image<float> x = io::read_image_float(a.string()), y = io::read_image_float(b.string());
-  if (x.width() != y.width() || x.height() != y.height() || x.channels() != y.channels()) return false;
+  if (x.width() != y.width() || x.height() != y.height() || x.channels() != y.channels())
+    return false;
   for (int r = 0; r < x.height(); ++r)
-    if (std::memcmp(x.row(r), y.row(r), sizeof(float) * x.width() * x.channels()) != 0) return false;
+    if (std::memcmp(x.row(r), y.row(r), sizeof(float) * x.width() * x.channels()) != 0)
+      return false;
   return true;
 }
 
@@ -154,7 +156,8 @@ class ShotCli : public ::testing::Test {
     const RunResult r = emaki("run shot.toml");
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_EQ(count_lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(key + ":"), std::string::npos) << "expected key " << key << " in: " << r.err;
+    EXPECT_NE(r.err.find(key + ":"), std::string::npos)
+        << "expected key " << key << " in: " << r.err;
     EXPECT_FALSE(fs::exists(dir_ / "out")) << "output written for: " << r.err;
   }
   std::string replaced(const std::string& from, const std::string& to) const {
@@ -181,7 +184,8 @@ TEST_F(ShotCli, UnknownSectionSuggestsTheClosest) {
 
 TEST_F(ShotCli, WrongTypeNamesTheExpectedType) {
   expect_bad(replaced("patch_size = 5", "patch_size = \"five\""), "layers.base.patch_size");
-  EXPECT_NE(emaki("run shot.toml").err.find("expected an integer, got a string"), std::string::npos);
+  EXPECT_NE(emaki("run shot.toml").err.find("expected an integer, got a string"),
+            std::string::npos);
 }
 
 TEST_F(ShotCli, FramesOfTheWrongType) {
@@ -192,7 +196,9 @@ TEST_F(ShotCli, MissingExemplarFile) {
   expect_bad(replaced("painting.png", "no_such_painting.png"), "exemplars.sphere.painting");
 }
 
-TEST_F(ShotCli, EmptyFrameRange) { expect_bad(replaced("frames = [0, 2]", "frames = []"), "source.frames"); }
+TEST_F(ShotCli, EmptyFrameRange) {
+  expect_bad(replaced("frames = [0, 2]", "frames = []"), "source.frames");
+}
 
 TEST_F(ShotCli, ReversedFrameRange) {
   expect_bad(replaced("frames = [0, 2]", "frames = [5, 2]"), "source.frames");
@@ -219,7 +225,9 @@ TEST_F(ShotCli, UnknownBlendMode) {
   EXPECT_NE(emaki("run shot.toml").err.find("did you mean 'multiply'"), std::string::npos);
 }
 
-TEST_F(ShotCli, EvenPatchSize) { expect_bad(replaced("patch_size = 5", "patch_size = 4"), "layers.base.patch_size"); }
+TEST_F(ShotCli, EvenPatchSize) {
+  expect_bad(replaced("patch_size = 5", "patch_size = 4"), "layers.base.patch_size");
+}
 
 TEST_F(ShotCli, MissingSceneFile) {
   expect_bad(replaced("scenes/Fox.glb", "scenes/NoFox.glb"), "source.scene");
@@ -229,13 +237,17 @@ TEST_F(ShotCli, SyntaxErrorNamesFileLineAndColumn) {
   expect_bad(replaced("frames = [0, 2]", "frames = [0, "), "shot.toml:6");
 }
 
-TEST_F(ShotCli, ClipNotInTheScene) { expect_bad(replaced("clip = \"Walk\"", "clip = \"Dance\""), "source.clip"); }
+TEST_F(ShotCli, ClipNotInTheScene) {
+  expect_bad(replaced("clip = \"Walk\"", "clip = \"Dance\""), "source.clip");
+}
 
 TEST_F(ShotCli, FrameRangePastTheClip) {
   expect_bad(replaced("frames = [0, 2]", "frames = [0, 5000]"), "source.frames");
 }
 
-TEST_F(ShotCli, ColourOutOfRange) { expect_bad(shot_text(2, "color = [2, 0, 0]"), "layers.base.color"); }
+TEST_F(ShotCli, ColourOutOfRange) {
+  expect_bad(shot_text(2, "color = [2, 0, 0]"), "layers.base.color");
+}
 
 TEST_F(ShotCli, SceneAndSequenceTogether) {
   expect_bad(replaced("clip = \"Walk\"", "sequence = \"r/frame_%04d.exr\""), "source");
@@ -249,22 +261,29 @@ TEST_F(ShotCli, MissingOutputsSection) {
 
 TEST_F(ShotCli, KeyframeExemplarAndItsPassesOfDifferentSizes) {
   // A 64x48 pass file from `emaki render` next to the 100x76 painting.
-  ASSERT_EQ(emaki("render " + kData + "/scenes/Fox.glb --frames 0-0 --size 64x48 --aa 1 --out renders").exit_code, 0);
+  ASSERT_EQ(
+      emaki("render " + kData + "/scenes/Fox.glb --frames 0-0 --size 64x48 --aa 1 --out renders")
+          .exit_code,
+      0);
   std::string exr;
   for (const auto& e : fs::directory_iterator(dir_ / "renders"))
     if (e.path().extension() == ".exr") exr = e.path().filename().string();
   ASSERT_FALSE(exr.empty());
   std::string s = shot_text();
   const std::size_t a = s.find("[exemplars.sphere]"), b = s.find("[layers.base]");
-  s.replace(a, b - a,
-            "[exemplars.sphere]\nkind = \"keyframe\"\npainting = \"painting.png\"\npasses = \"renders/" +
-                exr + "\"\n\n");
+  s.replace(
+      a, b - a,
+      "[exemplars.sphere]\nkind = \"keyframe\"\npainting = \"painting.png\"\npasses = \"renders/" +
+          exr + "\"\n\n");
   expect_bad(s, "exemplars.sphere.passes");
   EXPECT_NE(emaki("run shot.toml").err.find("64x48"), std::string::npos);
 }
 
 TEST_F(ShotCli, SequencePassChannelNotInTheExr) {
-  ASSERT_EQ(emaki("render " + kData + "/scenes/Fox.glb --frames 0-2 --size 64x48 --aa 1 --out renders").exit_code, 0);
+  ASSERT_EQ(
+      emaki("render " + kData + "/scenes/Fox.glb --frames 0-2 --size 64x48 --aa 1 --out renders")
+          .exit_code,
+      0);
   std::string exr;
   for (const auto& e : fs::directory_iterator(dir_ / "renders"))
     if (e.path().extension() == ".exr") exr = e.path().filename().string();
@@ -280,10 +299,14 @@ TEST_F(ShotCli, SequencePassChannelNotInTheExr) {
 }
 
 TEST_F(ShotCli, SequenceSourceAndKeyframeExemplarRun) {
-  ASSERT_EQ(emaki("render " + kData + "/scenes/Fox.glb --clip Walk --frames 0-2 --size 64x48 --aa 1 --out renders").exit_code, 0);
+  ASSERT_EQ(emaki("render " + kData +
+                  "/scenes/Fox.glb --clip Walk --frames 0-2 --size 64x48 --aa 1 --out renders")
+                .exit_code,
+            0);
   std::string exr;
   for (const auto& e : fs::directory_iterator(dir_ / "renders"))
-    if (e.path().extension() == ".exr" && e.path().filename().string().find("0000") != std::string::npos)
+    if (e.path().extension() == ".exr" &&
+        e.path().filename().string().find("0000") != std::string::npos)
       exr = e.path().filename().string();
   ASSERT_FALSE(exr.empty());
   const std::string pattern = std::regex_replace(exr, std::regex("[0-9]{4}"), "%04d");
@@ -297,8 +320,10 @@ TEST_F(ShotCli, SequenceSourceAndKeyframeExemplarRun) {
   std::string s = shot_text();
   const std::size_t a = s.find("scene = "), b = s.find("[layers.base]");
   s.replace(a, b - a,
-            "sequence = \"renders/" + pattern + "\"\nframes = [0, 2]\n\n[exemplars.sphere]\n"
-            "kind = \"keyframe\"\npainting = \"key.png\"\npasses = \"renders/" + exr + "\"\n\n");
+            "sequence = \"renders/" + pattern +
+                "\"\nframes = [0, 2]\n\n[exemplars.sphere]\n"
+                "kind = \"keyframe\"\npainting = \"key.png\"\npasses = \"renders/" +
+                exr + "\"\n\n");
   write_shot(s);
   const RunResult r = emaki("run shot.toml");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -320,8 +345,8 @@ TEST_F(ShotCli, CompositeRecoloursWithoutSynthesizing) {
   ASSERT_TRUE(fs::exists(comp));
   // The layered EXR holds every pass and every layer under distinct names.
   const std::vector<std::string> ch = io::list_channels(p("out/layered/frame_0001.exr"));
-  for (const char* name : {"normal.X", "outline.Y", "layer_base.Y", "layer_base.A", "layer_outline.Y",
-                           "composite.R"})
+  for (const char* name :
+       {"normal.X", "outline.Y", "layer_base.Y", "layer_base.A", "layer_outline.Y", "composite.R"})
     EXPECT_NE(std::find(ch.begin(), ch.end(), name), ch.end()) << name;
   EXPECT_EQ(ch.size(), 24u + 2 + 2 + 3);
   const std::string layer_before = slurp(layer), comp_before = slurp(comp);

@@ -26,8 +26,10 @@ struct RunResult {
 };
 
 RunResult run(const std::string& args) {
-  const fs::path err_file = fs::temp_directory_path() / ("emaki_cli_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(EMAKI_BINARY) + " synth " + args + " 2>" + err_file.string() + " >/dev/null";
+  const fs::path err_file =
+      fs::temp_directory_path() / ("emaki_cli_err_" + std::to_string(::getpid()));
+  const std::string cmd =
+      std::string(EMAKI_BINARY) + " synth " + args + " 2>" + err_file.string() + " >/dev/null";
   const int status = std::system(cmd.c_str());
   std::ifstream f(err_file);
   std::stringstream ss;
@@ -45,8 +47,9 @@ int count_lines(const std::string& s) {
 class SynthCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("emaki_cli_" + std::to_string(::getpid()) + "_" +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() /
+           ("emaki_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     write("style.png", 48, 40, 3, 1);
     write("src.png", 48, 40, 1, 2);
@@ -67,8 +70,10 @@ class SynthCli : public ::testing::Test {
           im(x, y, k) = 0.5f * rng.uniform_float() + 0.5f * float(x + y) / float(w + h);
         }
     io::WriteOptions o;
-    if (exr) o.format = io::SampleFormat::kFloat;
-    else o.format = io::SampleFormat::kU8;
+    if (exr)
+      o.format = io::SampleFormat::kFloat;
+    else
+      o.format = io::SampleFormat::kU8;
     io::write_image(p(name), im.cview(), o);
   }
 
@@ -92,7 +97,9 @@ class SynthCli : public ::testing::Test {
 };
 
 TEST_F(SynthCli, EbSynthCommandLineWritesOutput) {
-  const RunResult r = run(basic() + " -output " + p("out.png") + " -uniformity 3500 -patchsize 5 -pyramidlevels 3 -searchvoteiters 2 -patchmatchiters 2 -stopthreshold 5 -extrapass3x3 -backend cpu");
+  const RunResult r = run(basic() + " -output " + p("out.png") +
+                          " -uniformity 3500 -patchsize 5 -pyramidlevels 3 -searchvoteiters 2 "
+                          "-patchmatchiters 2 -stopthreshold 5 -extrapass3x3 -backend cpu");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const io::AnyImage out = io::read_image(p("out.png"));
   EXPECT_EQ(out.width(), 56);
@@ -102,7 +109,9 @@ TEST_F(SynthCli, EbSynthCommandLineWritesOutput) {
 
 TEST_F(SynthCli, SameOutputForOneAndTwoThreadsAndExtrasWritten) {
   ASSERT_EQ(run(basic() + " -output " + p("a.png") + " --threads 1 --nnf-out " + p("nnf.exr") +
-                " --error-out " + p("err.exr")).exit_code, 0);
+                " --error-out " + p("err.exr"))
+                .exit_code,
+            0);
   ASSERT_EQ(run(basic() + " -output " + p("b.png") + " --threads 2").exit_code, 0);
   std::ifstream a(p("a.png"), std::ios::binary), b(p("b.png"), std::ios::binary);
   std::stringstream sa, sb;
@@ -142,10 +151,10 @@ TEST_F(SynthCli, HelpDocumentsEveryOption) {
   char buf[4096];
   while (std::size_t n = fread(buf, 1, sizeof buf, f)) text.append(buf, n);
   EXPECT_EQ(pclose(f), 0);
-  for (const char* opt : {"-style", "-guide", "-weight", "-output", "-uniformity", "-patchsize",
-                          "-pyramidlevels", "-searchvoteiters", "-patchmatchiters",
-                          "-extrapass3x3", "-backend", "--seed", "--threads", "--mask",
-                          "--nnf-out", "--error-out", "Default"})
+  for (const char* opt :
+       {"-style", "-guide", "-weight", "-output", "-uniformity", "-patchsize", "-pyramidlevels",
+        "-searchvoteiters", "-patchmatchiters", "-extrapass3x3", "-backend", "--seed", "--threads",
+        "--mask", "--nnf-out", "--error-out", "Default"})
     EXPECT_NE(text.find(opt), std::string::npos) << opt;
 }
 
@@ -176,9 +185,9 @@ TEST_F(SynthCli, TargetGuidesOfDifferentSizes) {
 }
 
 TEST_F(SynthCli, GuideWithOnePath) {
-  expect_error("-style " + p("style.png") + " -guide " + p("src.png") + " -weight 0.5 -output " +
-                   p("o.png"),
-               "-guide", p("o.png"));
+  expect_error(
+      "-style " + p("style.png") + " -guide " + p("src.png") + " -weight 0.5 -output " + p("o.png"),
+      "-guide", p("o.png"));
 }
 
 TEST_F(SynthCli, EvenPatchSize) {

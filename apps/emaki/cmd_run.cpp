@@ -1,14 +1,13 @@
 // `emaki run SHOT`: a whole shot — every layer of every frame, the temporal chain, compositing,
 // previews — resuming after the last finished frame. `emaki composite SHOT` re-colours finished
 // layers without synthesizing. `emaki qa flicker SHOT --layer NAME` measures temporal error.
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_options.h"
@@ -72,12 +71,14 @@ std::function<void(const pipeline::Progress&)> progress_printer(const char* comm
       line = fmt::format("emaki {}: frame {} compositing", command, p.frame);
     } else {
       const double eta = p.done > 0 ? p.elapsed_s / p.done * (p.total - p.done) : NAN;
-      line = fmt::format("emaki {}: frame {} layer {} ({}/{}, {} elapsed, ETA {})", command,
-                         p.frame, p.layer, p.done + 1, p.total, duration(p.elapsed_s),
-                         duration(eta));
+      line =
+          fmt::format("emaki {}: frame {} layer {} ({}/{}, {} elapsed, ETA {})", command, p.frame,
+                      p.layer, p.done + 1, p.total, duration(p.elapsed_s), duration(eta));
     }
-    if (tty) std::fprintf(stderr, "\r\033[K%s", line.c_str());
-    else std::fprintf(stderr, "%s\n", line.c_str());
+    if (tty)
+      std::fprintf(stderr, "\r\033[K%s", line.c_str());
+    else
+      std::fprintf(stderr, "%s\n", line.c_str());
     std::fflush(stderr);
   };
 }
@@ -89,10 +90,11 @@ void end_progress_line() {
 }  // namespace
 
 int run_run(const Args& args) {
-  CLI::App app{"Runs a shot file: synthesizes every layer of every frame (with the temporal "
-               "chain), composites them over the paper and writes the outputs the shot asks "
-               "for. Re-running resumes after the last finished frame.",
-               "emaki run"};
+  CLI::App app{
+      "Runs a shot file: synthesizes every layer of every frame (with the temporal "
+      "chain), composites them over the paper and writes the outputs the shot asks "
+      "for. Re-running resumes after the last finished frame.",
+      "emaki run"};
   std::string shot_path, frames, layers;
   bool force = false, no_previews = false;
   int threads = -1;
@@ -132,9 +134,10 @@ int run_run(const Args& args) {
 }
 
 int run_composite(const Args& args) {
-  CLI::App app{"Re-composites a shot's finished layers with the colours, filters, blend modes "
-               "and paper now in the shot file, without synthesizing again.",
-               "emaki composite"};
+  CLI::App app{
+      "Re-composites a shot's finished layers with the colours, filters, blend modes "
+      "and paper now in the shot file, without synthesizing again.",
+      "emaki composite"};
   std::string shot_path, frames;
   bool no_previews = false;
   int threads = -1;
@@ -163,10 +166,11 @@ int run_composite(const Args& args) {
 int run_qa(const Args& args) {
   if (args.empty() || args[0] != "flicker")
     throw Error("", "usage: emaki qa flicker SHOT --layer NAME [--frames A-B]");
-  CLI::App app{"Temporal error of a layer's frames: mean |B'(t) - B'(t-1)| sampled along the "
-               "renderer's motion vectors over pixels visible in both frames, split into scene "
-               "objects and ground. Prints a table and a JSON line.",
-               "emaki qa flicker"};
+  CLI::App app{
+      "Temporal error of a layer's frames: mean |B'(t) - B'(t-1)| sampled along the "
+      "renderer's motion vectors over pixels visible in both frames, split into scene "
+      "objects and ground. Prints a table and a JSON line.",
+      "emaki qa flicker"};
   std::string shot_path, frames, layer;
   int threads = -1;
   app.add_option("shot", shot_path, "the shot file")->required();
@@ -189,7 +193,8 @@ int run_qa(const Args& args) {
   io::FileStore store(shot);
   for (int f = a; f <= b; ++f)
     if (!store.has_layer(*l, f))
-      throw Error(fmt::format("layers.{}", layer), fmt::format("frame {} is not synthesized yet", f));
+      throw Error(fmt::format("layers.{}", layer),
+                  fmt::format("frame {} is not synthesized yet", f));
   const int value_channels = l->single_colour ? 1 : 3;
   std::printf("%-6s %12s %12s %12s %9s\n", "frame", "all", "objects", "ground", "pixels");
   pipeline::FlickerStats all, objects, ground;
@@ -209,9 +214,10 @@ int run_qa(const Args& args) {
     prev_passes = std::move(cur_passes);
   }
   std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", all.mean(), objects.mean(), ground.mean());
-  std::printf("{\"layer\": \"%s\", \"frames\": [%d, %d], \"mean\": %.6f, \"objects\": %.6f, "
-              "\"ground\": %.6f}\n",
-              layer.c_str(), a, b, all.mean(), objects.mean(), ground.mean());
+  std::printf(
+      "{\"layer\": \"%s\", \"frames\": [%d, %d], \"mean\": %.6f, \"objects\": %.6f, "
+      "\"ground\": %.6f}\n",
+      layer.c_str(), a, b, all.mean(), objects.mean(), ground.mean());
   return 0;
 }
 

@@ -1,12 +1,13 @@
 // `emaki synth`: guided synthesis from files. Accepts EbSynth's command line unchanged (single-
 // dash options, `-weight` applying to the -style or -guide before it), so scripts that call
 // `ebsynth` switch by changing the program name; adds long options of its own.
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fmt/format.h>
 #include <optional>
 #include <string>
 
@@ -19,7 +20,8 @@
 namespace emaki::app {
 namespace {
 
-constexpr const char* kHelp = R"(usage: emaki synth -style A'.png -guide A1.png B1.png [-weight W] [-guide ...] -output B'.png [options]
+constexpr const char* kHelp =
+    R"(usage: emaki synth -style A'.png -guide A1.png B1.png [-weight W] [-guide ...] -output B'.png [options]
 
 Guided patch-based synthesis (A : A' :: B : B'). Accepts EbSynth's command line unchanged.
 
@@ -188,8 +190,10 @@ int run_synth(const Args& args) {
       if (params.uniformity < 0.0f) throw Error(a, "must be >= 0");
     } else if (a == "-patchsize") {
       params.patch_size = parse_int(a, need(i, a));
-      if (params.patch_size < 3) throw Error(a, fmt::format("must be >= 3 (got {})", params.patch_size));
-      if (params.patch_size % 2 == 0) throw Error(a, fmt::format("must be odd (got {})", params.patch_size));
+      if (params.patch_size < 3)
+        throw Error(a, fmt::format("must be >= 3 (got {})", params.patch_size));
+      if (params.patch_size % 2 == 0)
+        throw Error(a, fmt::format("must be odd (got {})", params.patch_size));
     } else if (a == "-pyramidlevels") {
       params.pyramid_levels = parse_int(a, need(i, a));
       if (params.pyramid_levels < 1) throw Error(a, "must be >= 1");
@@ -223,9 +227,12 @@ int run_synth(const Args& args) {
       mask_path = need(i, a);
     } else if (a == "--vote") {
       const std::string v = need(i, a);
-      if (v == "plain") params.vote_mode = synth::VoteMode::kPlain;
-      else if (v == "weighted") params.vote_mode = synth::VoteMode::kWeighted;
-      else throw Error(a, "must be plain or weighted (got '" + v + "')");
+      if (v == "plain")
+        params.vote_mode = synth::VoteMode::kPlain;
+      else if (v == "weighted")
+        params.vote_mode = synth::VoteMode::kWeighted;
+      else
+        throw Error(a, "must be plain or weighted (got '" + v + "')");
     } else if (a == "--nnf-out") {
       nnf_out = need(i, a);
     } else if (a == "--error-out") {
@@ -281,9 +288,9 @@ int run_synth(const Args& args) {
     io::AnyImage s = std::move(files[1 + 2 * k]);
     io::AnyImage t = std::move(files[2 + 2 * k]);
     if (s.width() != style.width() || s.height() != style.height())
-      throw Error(g.source, fmt::format("source guide is {}x{} but the style '{}' is {}x{}",
-                                        s.width(), s.height(), style_path, style.width(),
-                                        style.height()));
+      throw Error(g.source,
+                  fmt::format("source guide is {}x{} but the style '{}' is {}x{}", s.width(),
+                              s.height(), style_path, style.width(), style.height()));
     const int nc = std::max(effective_channels(s), effective_channels(t));
     if (nc > 4) throw Error(g.source, "a guide must have 1 to 4 channels");
     loaded.push_back(reduce(std::move(s), std::min(nc, 4)));
@@ -330,12 +337,18 @@ int run_synth(const Args& args) {
   const auto t1 = std::chrono::steady_clock::now();
 
   io::WriteOptions wo;
-  if (depth == "8") wo.format = io::SampleFormat::kU8;
-  else if (depth == "16") wo.format = io::SampleFormat::kU16;
-  else if (depth == "float") wo.format = io::SampleFormat::kFloat;
-  else if (style.type() == io::PixelType::kU8) wo.format = io::SampleFormat::kU8;
-  else if (style.type() == io::PixelType::kU16) wo.format = io::SampleFormat::kU16;
-  else wo.format = io::SampleFormat::kFloat;
+  if (depth == "8")
+    wo.format = io::SampleFormat::kU8;
+  else if (depth == "16")
+    wo.format = io::SampleFormat::kU16;
+  else if (depth == "float")
+    wo.format = io::SampleFormat::kFloat;
+  else if (style.type() == io::PixelType::kU8)
+    wo.format = io::SampleFormat::kU8;
+  else if (style.type() == io::PixelType::kU16)
+    wo.format = io::SampleFormat::kU16;
+  else
+    wo.format = io::SampleFormat::kFloat;
   // A one-channel style whose file was RGB is written back as RGB, as EbSynth does.
   Image<float> out_img;
   const int ns = synth::plane_channels(in.style);
@@ -368,10 +381,10 @@ int run_synth(const Args& args) {
     io::write_image(error_out, res.error.cview(), o);
   }
   if (!quiet)
-    std::fprintf(stderr, "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
+    std::fprintf(stderr,
+                 "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
                  out_img.width(), out_img.height(), style.width(), style.height(), ns,
-                 guides.size(), res.pyramid_levels,
-                 std::chrono::duration<double>(t1 - t0).count());
+                 guides.size(), res.pyramid_levels, std::chrono::duration<double>(t1 - t0).count());
   return 0;
 }
 

@@ -18,8 +18,7 @@ const std::vector<Command>& commands() {
        run_template},
       {"run", "a whole shot from its shot file: layers, temporal chain, compositing, previews",
        run_run},
-      {"composite", "re-colour a shot's finished layers without synthesizing again",
-       run_composite},
+      {"composite", "re-colour a shot's finished layers without synthesizing again", run_composite},
       {"qa", "quality checks: 'emaki qa flicker SHOT --layer NAME'", run_qa},
   };
   return list;

@@ -1,9 +1,9 @@
 #include "composite/composite.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -11,14 +11,16 @@
 namespace emaki::composite {
 
 namespace {
-float clamp01(float v) { return std::clamp(v, 0.0f, 1.0f); }
+float clamp01(float v) {
+  return std::clamp(v, 0.0f, 1.0f);
+}
 
 void check_size(const std::string& layer, const char* what, ImageView<const float> v, int width,
                 int height) {
   if (v.width != width || v.height != height)
-    throw Error(fmt::format("layers.{}", layer),
-                fmt::format("{} is {}x{}, the output is {}x{}", what, v.width, v.height, width,
-                            height));
+    throw Error(
+        fmt::format("layers.{}", layer),
+        fmt::format("{} is {}x{}, the output is {}x{}", what, v.width, v.height, width, height));
 }
 }  // namespace
 
@@ -42,9 +44,12 @@ Image<float> touch(ImageView<const float> image, int channel) {
       for (int x = 0; x < image.width; ++x) {
         const float* p = image.at(x, y);
         float v;
-        if (channel >= 0) v = p[channel];
-        else if (rgb) v = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
-        else v = p[0];
+        if (channel >= 0)
+          v = p[channel];
+        else if (rgb)
+          v = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
+        else
+          v = p[0];
         out(x, y) = v;
       }
   });
@@ -81,9 +86,12 @@ Color hue_saturation(Color c, float hue_deg, float saturation) {
   const float d = mx - mn;
   float h = 0.0f;
   if (d > 0.0f) {
-    if (mx == c.r) h = std::fmod((c.g - c.b) / d + 6.0f, 6.0f);
-    else if (mx == c.g) h = (c.b - c.r) / d + 2.0f;
-    else h = (c.r - c.g) / d + 4.0f;
+    if (mx == c.r)
+      h = std::fmod((c.g - c.b) / d + 6.0f, 6.0f);
+    else if (mx == c.g)
+      h = (c.b - c.r) / d + 2.0f;
+    else
+      h = (c.r - c.g) / d + 4.0f;
   }
   float s = mx > 0.0f ? d / mx : 0.0f;
   const float v = mx;
@@ -96,21 +104,36 @@ Color hue_saturation(Color c, float hue_deg, float saturation) {
   const float m = v - cc;
   float r = 0, g = 0, b = 0;
   switch (int(h) % 6) {
-    case 0: r = cc, g = x; break;
-    case 1: r = x, g = cc; break;
-    case 2: g = cc, b = x; break;
-    case 3: g = x, b = cc; break;
-    case 4: r = x, b = cc; break;
-    default: r = cc, b = x; break;
+    case 0:
+      r = cc, g = x;
+      break;
+    case 1:
+      r = x, g = cc;
+      break;
+    case 2:
+      g = cc, b = x;
+      break;
+    case 3:
+      g = x, b = cc;
+      break;
+    case 4:
+      r = x, b = cc;
+      break;
+    default:
+      r = cc, b = x;
+      break;
   }
   return {r + m, g + m, b + m};
 }
 
 float blend(BlendMode mode, float a, float b) {
   switch (mode) {
-    case BlendMode::kNormal: return b;
-    case BlendMode::kMultiply: return a * b;
-    case BlendMode::kScreen: return 1.0f - (1.0f - a) * (1.0f - b);
+    case BlendMode::kNormal:
+      return b;
+    case BlendMode::kMultiply:
+      return a * b;
+    case BlendMode::kScreen:
+      return 1.0f - (1.0f - a) * (1.0f - b);
     case BlendMode::kOverlay:
       return a < 0.5f ? 2.0f * a * b : 1.0f - 2.0f * (1.0f - a) * (1.0f - b);
   }
@@ -145,15 +168,20 @@ Image<float> color_layer(const LayerInput& layer, int width, int height) {
         if (n == 3) {
           c = {apply_levels(clamp01(p[0]), f), apply_levels(clamp01(p[1]), f),
                apply_levels(clamp01(p[2]), f)};
-        } else switch (look.source) {
-          case ColorSource::kAlbedo: {
-            const float* a = layer.albedo.at(x, y);
-            c = {srgb_encode(a[0]) * v, srgb_encode(a[1]) * v, srgb_encode(a[2]) * v};
-            break;
+        } else
+          switch (look.source) {
+            case ColorSource::kAlbedo: {
+              const float* a = layer.albedo.at(x, y);
+              c = {srgb_encode(a[0]) * v, srgb_encode(a[1]) * v, srgb_encode(a[2]) * v};
+              break;
+            }
+            case ColorSource::kFlat:
+              c = {look.flat.r * v, look.flat.g * v, look.flat.b * v};
+              break;
+            case ColorSource::kGradient:
+              c = sample_gradient(look.gradient, v);
+              break;
           }
-          case ColorSource::kFlat: c = {look.flat.r * v, look.flat.g * v, look.flat.b * v}; break;
-          case ColorSource::kGradient: c = sample_gradient(look.gradient, v); break;
-        }
         c = {c.r * f.tint.r, c.g * f.tint.g, c.b * f.tint.b};
         c = hue_saturation(c, f.hue_deg, f.saturation);
         // A colour layer's value, for coverage, is its luma.

@@ -9,10 +9,10 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
-#include <thread>
-#include <vector>
 #include <memory>
 #include <mutex>
+#include <thread>
+#include <vector>
 
 namespace emaki {
 namespace {
@@ -24,8 +24,9 @@ tbb::task_arena& arena() {
   std::lock_guard lock(g_mutex);
   // Without this, TBB sizes its worker pool by the first arena it sees: a first run with one
   // thread would cap every later run at one. Allowing plenty lets each arena get what it asks.
-  static tbb::global_control allow(tbb::global_control::max_allowed_parallelism,
-                                   std::max<std::size_t>(64, tbb::this_task_arena::max_concurrency()));
+  static tbb::global_control allow(
+      tbb::global_control::max_allowed_parallelism,
+      std::max<std::size_t>(64, tbb::this_task_arena::max_concurrency()));
   if (!g_arena) {
     const int n = g_threads > 0 ? g_threads : tbb::this_task_arena::max_concurrency();
     g_arena = std::make_unique<tbb::task_arena>(n);
@@ -40,7 +41,9 @@ void set_thread_count(int n) {
   g_arena.reset();
 }
 
-int thread_count() { return arena().max_concurrency(); }
+int thread_count() {
+  return arena().max_concurrency();
+}
 
 void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn) {
   if (n <= 0) return;
@@ -59,7 +62,8 @@ void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, in
   std::exception_ptr failed;
   auto worker = [&] {
     try {
-      for (int64_t c; (c = next.fetch_add(1)) < chunks;) fn(c * grain, std::min(n, (c + 1) * grain));
+      for (int64_t c; (c = next.fetch_add(1)) < chunks;)
+        fn(c * grain, std::min(n, (c + 1) * grain));
     } catch (...) {
       std::lock_guard lock(failed_mutex);
       if (!failed) failed = std::current_exception();
@@ -78,7 +82,8 @@ void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, in
     tbb::parallel_for(
         tbb::blocked_range<int64_t>(0, chunks, 1),
         [&](const tbb::blocked_range<int64_t>& r) {
-          for (int64_t c = r.begin(); c != r.end(); ++c) fn(c * grain, std::min(n, (c + 1) * grain));
+          for (int64_t c = r.begin(); c != r.end(); ++c)
+            fn(c * grain, std::min(n, (c + 1) * grain));
         },
         tbb::simple_partitioner());
   });

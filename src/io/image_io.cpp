@@ -1,6 +1,7 @@
 #include "io/image_io.h"
 
 #include <dlfcn.h>
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,7 +9,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "io/oiio_backend.h"
@@ -30,15 +30,20 @@ int AnyImage::channels() const {
   return std::visit([](const auto& im) { return im.channels(); }, image);
 }
 PixelType AnyImage::type() const {
-  return image.index() == 0 ? PixelType::kU8 : image.index() == 1 ? PixelType::kU16 : PixelType::kF32;
+  return image.index() == 0   ? PixelType::kU8
+         : image.index() == 1 ? PixelType::kU16
+                              : PixelType::kF32;
 }
 
 namespace {
 template <typename T>
 float normalised(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>) return v * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>) return v * (1.0f / 65535.0f);
-  else return v;
+  if constexpr (std::is_same_v<T, uint8_t>)
+    return v * (1.0f / 255.0f);
+  else if constexpr (std::is_same_v<T, uint16_t>)
+    return v * (1.0f / 65535.0f);
+  else
+    return v;
 }
 }  // namespace
 
@@ -211,8 +216,7 @@ Image<float> read_image_float(const std::string& path, const ReadOptions& option
 
 bool is_writable_extension(const std::string& path) {
   const std::string e = lower_ext(path);
-  return e == ".png" || e == ".exr" || e == ".tif" || e == ".tiff" || e == ".jpg" ||
-         e == ".jpeg";
+  return e == ".png" || e == ".exr" || e == ".tif" || e == ".tiff" || e == ".jpg" || e == ".jpeg";
 }
 
 void check_writable(const std::string& path) {
@@ -233,11 +237,20 @@ void write_image(const std::string& path, ImageView<const float> image,
   // 0 u8, 1 u16, 2 half, 3 float
   int type = 1;
   switch (options.format) {
-    case SampleFormat::kU8: type = 0; break;
-    case SampleFormat::kU16: type = 1; break;
-    case SampleFormat::kHalf: type = 2; break;
-    case SampleFormat::kFloat: type = 3; break;
-    case SampleFormat::kAuto: type = ext == ".exr" ? 2 : (ext == ".jpg" || ext == ".jpeg") ? 0 : 1;
+    case SampleFormat::kU8:
+      type = 0;
+      break;
+    case SampleFormat::kU16:
+      type = 1;
+      break;
+    case SampleFormat::kHalf:
+      type = 2;
+      break;
+    case SampleFormat::kFloat:
+      type = 3;
+      break;
+    case SampleFormat::kAuto:
+      type = ext == ".exr" ? 2 : (ext == ".jpg" || ext == ".jpeg") ? 0 : 1;
   }
   if (ext == ".exr" && type < 2) type = 2;
   if (ext == ".jpg" || ext == ".jpeg") type = 0;
@@ -254,16 +267,16 @@ void write_image(const std::string& path, ImageView<const float> image,
   }
 
   const fs::path target(path);
-  const fs::path tmp = target.parent_path() /
-                       fmt::format(".{}.tmp{}{}", target.stem().string(), ::getpid(), ext);
+  const fs::path tmp =
+      target.parent_path() / fmt::format(".{}.tmp{}{}", target.stem().string(), ::getpid(), ext);
   std::error_code ec;
   try {
     if (ext == ".png") {
       detail::write_png(tmp.string(), image, type == 1, path);
     } else {
       std::lock_guard lock(detail::oiio_mutex());
-      if (std::string e = detail::oiio_backend(path).write(tmp.string(), image,
-                                                           options.channel_names, type);
+      if (std::string e =
+              detail::oiio_backend(path).write(tmp.string(), image, options.channel_names, type);
           !e.empty())
         throw Error(path, e);
     }

@@ -1,4 +1,6 @@
 // Round trips through image files, and the errors that name the file.
+#include "io/image_io.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -8,7 +10,6 @@
 #include <limits>
 
 #include "core/error.h"
-#include "io/image_io.h"
 
 namespace fs = std::filesystem;
 
@@ -32,7 +33,8 @@ Image<float> ramp(int w, int h, int c, int levels) {
   Image<float> im(w, h, c);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      for (int k = 0; k < c; ++k) im(x, y, k) = float((x * 7 + y * 13 + k * 101) % levels) / float(levels - 1);
+      for (int k = 0; k < c; ++k)
+        im(x, y, k) = float((x * 7 + y * 13 + k * 101) % levels) / float(levels - 1);
   return im;
 }
 
@@ -48,7 +50,8 @@ TEST_F(ImageIo, Png8BitRoundTripIsExact) {
     for (int y = 0; y < 21; ++y)
       for (int x = 0; x < 37; ++x)
         for (int k = 0; k < c; ++k)
-          ASSERT_EQ(std::get<Image<uint8_t>>(back.image)(x, y, k), std::lround(im(x, y, k) * 255.0f));
+          ASSERT_EQ(std::get<Image<uint8_t>>(back.image)(x, y, k),
+                    std::lround(im(x, y, k) * 255.0f));
   }
 }
 
@@ -60,7 +63,8 @@ TEST_F(ImageIo, Png16BitRoundTripIsExact) {
   for (int y = 0; y < 30; ++y)
     for (int x = 0; x < 40; ++x)
       for (int k = 0; k < 3; ++k)
-        ASSERT_EQ(std::get<Image<uint16_t>>(back.image)(x, y, k), std::lround(im(x, y, k) * 65535.0f));
+        ASSERT_EQ(std::get<Image<uint16_t>>(back.image)(x, y, k),
+                  std::lround(im(x, y, k) * 65535.0f));
 }
 
 TEST_F(ImageIo, FloatExrRoundTripIsExactWithNamedChannels) {

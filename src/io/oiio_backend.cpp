@@ -2,9 +2,9 @@
 #include "io/oiio_backend.h"
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 
 #include <cmath>
-#include <fmt/format.h>
 #include <memory>
 
 namespace emaki::io::detail {
@@ -95,7 +95,8 @@ std::string read_impl(const std::string& path, const ReadOptions& options, AnyIm
       for (int c = 0; c < spec.nchannels; ++c) {
         if (spec.channelnames[c] != want) continue;
         where.push_back({sub, c});
-        if (width < 0) width = spec.width, height = spec.height;
+        if (width < 0)
+          width = spec.width, height = spec.height;
         else if (spec.width != width || spec.height != height)
           return "channel '" + want + "' has a different size from the others";
         found = true;
@@ -138,8 +139,10 @@ std::string write_impl(const std::string& path, ImageView<const float> image,
               buf.data() + std::size_t(y) * image.width * image.channels);
   }
   auto out = ImageOutput::create(path);
-  if (!out) return "cannot create image writer (" + first_line(OIIO::geterror(), "unknown format") + ")";
-  if (!out->open(path, spec)) return "cannot open for writing (" + first_line(out->geterror(), "") + ")";
+  if (!out)
+    return "cannot create image writer (" + first_line(OIIO::geterror(), "unknown format") + ")";
+  if (!out->open(path, spec))
+    return "cannot open for writing (" + first_line(out->geterror(), "") + ")";
   const bool ok = out->write_image(TypeDesc::FLOAT, buf.data());
   const bool closed = out->close();
   if (!ok || !closed) return "write failed (" + first_line(out->geterror(), "") + ")";

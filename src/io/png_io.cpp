@@ -84,8 +84,7 @@ AnyImage read_png(const std::string& path) {
 
 void write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
                const std::string& subject) {
-  if (image.channels < 1 || image.channels > 4)
-    throw Error(subject, "PNG takes 1 to 4 channels");
+  if (image.channels < 1 || image.channels > 4) throw Error(subject, "PNG takes 1 to 4 channels");
   std::unique_ptr<FILE, FileCloser> file(std::fopen(path.c_str(), "wb"));
   if (!file) throw Error(subject, "cannot open for writing");
   const int w = image.width, h = image.height, nc = image.channels;

@@ -1,5 +1,7 @@
 #include "io/shot_file.h"
 
+#include <fmt/format.h>
+#include <toml++/toml.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,9 +11,6 @@
 #include <map>
 #include <set>
 #include <sstream>
-
-#include <fmt/format.h>
-#include <toml++/toml.h>
 
 #include "core/error.h"
 #include "io/image_io.h"
@@ -51,13 +50,20 @@ namespace {
 
 const char* type_name(const toml::node& n) {
   switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    default: return "a date/time";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    default:
+      return "a date/time";
   }
 }
 
@@ -97,9 +103,12 @@ class Reader {
     const toml::node* n = node(key);
     if (!n) return fallback;
     double v;
-    if (auto i = n->value_exact<int64_t>()) v = double(*i);
-    else if (auto f = n->value_exact<double>()) v = *f;
-    else type_error(key, *n, "a number");
+    if (auto i = n->value_exact<int64_t>())
+      v = double(*i);
+    else if (auto f = n->value_exact<double>())
+      v = *f;
+    else
+      type_error(key, *n, "a number");
     check_range(key, v, lo, hi);
     return v;
   }
@@ -144,14 +153,18 @@ class Reader {
     const toml::node* n = node(key);
     CHECK(n != nullptr);
     const toml::array* a = n->as_array();
-    const std::string expected =
-        count > 0 ? fmt::format("an array of {} numbers", count) : std::string("an array of numbers");
+    const std::string expected = count > 0 ? fmt::format("an array of {} numbers", count)
+                                           : std::string("an array of numbers");
     if (!a) type_error(key, *n, expected.c_str());
     std::vector<float> out;
     for (const toml::node& e : *a) {
-      if (auto i = e.value_exact<int64_t>()) out.push_back(float(*i));
-      else if (auto f = e.value_exact<double>()) out.push_back(float(*f));
-      else throw Error(key_path(key), fmt::format("expected {}, found {} in it", expected, type_name(e)));
+      if (auto i = e.value_exact<int64_t>())
+        out.push_back(float(*i));
+      else if (auto f = e.value_exact<double>())
+        out.push_back(float(*f));
+      else
+        throw Error(key_path(key),
+                    fmt::format("expected {}, found {} in it", expected, type_name(e)));
       if (!std::isfinite(out.back())) throw Error(key_path(key), "values must be finite");
     }
     if ((count > 0 && int(out.size()) != count) || out.empty())
@@ -199,9 +212,12 @@ class Reader {
   void check_range(std::string_view key, double v, double lo, double hi) {
     if (!(v >= lo && v <= hi)) {
       std::string range;
-      if (lo == -HUGE_VAL) range = fmt::format("<= {}", hi);
-      else if (hi == HUGE_VAL) range = fmt::format(">= {}", lo);
-      else range = fmt::format("in [{}, {}]", lo, hi);
+      if (lo == -HUGE_VAL)
+        range = fmt::format("<= {}", hi);
+      else if (hi == HUGE_VAL)
+        range = fmt::format(">= {}", lo);
+      else
+        range = fmt::format("in [{}, {}]", lo, hi);
       throw Error(key_path(key), fmt::format("must be {}, got {}", range, v));
     }
   }
@@ -258,7 +274,7 @@ void check_pattern(const std::string& key, const std::string& pattern) {
 
 void parse_camera(Reader& r, scene::CameraSpec& c) {
   const std::string mode = r.choice("mode", "auto", {"auto", "look_at", "gltf"});
-  c.mode = mode == "auto" ? scene::CameraSpec::Mode::kAuto
+  c.mode = mode == "auto"      ? scene::CameraSpec::Mode::kAuto
            : mode == "look_at" ? scene::CameraSpec::Mode::kLookAt
                                : scene::CameraSpec::Mode::kGltf;
   c.position = r.vec3("position", c.position);
@@ -290,13 +306,15 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     std::vector<int> f;
     for (const toml::node& e : *a) {
       auto i = e.value_exact<int64_t>();
-      if (!i) throw Error(r.key_path("frames"), fmt::format("expected integers, found {}", type_name(e)));
+      if (!i)
+        throw Error(r.key_path("frames"), fmt::format("expected integers, found {}", type_name(e)));
       f.push_back(int(*i));
     }
     if (f.size() != 2)
-      throw Error(r.key_path("frames"),
-                  fmt::format("expected [first, last], got {} value{}", f.size(), f.size() == 1 ? "" : "s"));
-    if (f[0] < 0) throw Error(r.key_path("frames"), fmt::format("frames must be >= 0, got {}", f[0]));
+      throw Error(r.key_path("frames"), fmt::format("expected [first, last], got {} value{}",
+                                                    f.size(), f.size() == 1 ? "" : "s"));
+    if (f[0] < 0)
+      throw Error(r.key_path("frames"), fmt::format("frames must be >= 0, got {}", f[0]));
     if (f[1] < f[0])
       throw Error(r.key_path("frames"),
                   fmt::format("the range [{}, {}] is reversed (last before first)", f[0], f[1]));
@@ -311,7 +329,8 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     const std::vector<float> size = r.numbers("size", 2);
     for (float v : size)
       if (v < 1 || v > 16384 || v != std::floor(v))
-        throw Error(r.key_path("size"), fmt::format("width and height must be integers in [1, 16384], got {}", v));
+        throw Error(r.key_path("size"),
+                    fmt::format("width and height must be integers in [1, 16384], got {}", v));
     s.width = int(size[0]);
     s.height = int(size[1]);
     s.shot.clip = r.string("clip", "");
@@ -343,18 +362,20 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       Reader g(*t, r.key_path("ground"), {"enabled", "size", "height", "color"});
       s.shot.ground.enabled = g.boolean("enabled", true);
       s.shot.ground.size = g.real("size", 0.0f, 0.0);
-      if (g.has("height")) s.shot.ground.height = g.real("height", 0.0f), s.shot.ground.auto_height = false;
+      if (g.has("height"))
+        s.shot.ground.height = g.real("height", 0.0f), s.shot.ground.auto_height = false;
       const composite::Color c = g.color("color", {0.8f, 0.8f, 0.8f});
       s.shot.ground.color = {c.r, c.g, c.b};
     }
-    if (r.has("channels")) throw Error(r.key_path("channels"), "applies to a 'sequence' source only");
+    if (r.has("channels"))
+      throw Error(r.key_path("channels"), "applies to a 'sequence' source only");
   } else {
     s.kind = pipeline::SourceKind::kSequence;
     const std::string raw = r.string("sequence", "");
     check_pattern(r.key_path("sequence"), raw);
     s.pattern = ctx.resolve(raw);
-    for (const char* k : {"clip", "start", "aa", "outline_width", "crease", "camera", "light", "ground",
-                          "background", "size"})
+    for (const char* k : {"clip", "start", "aa", "outline_width", "crease", "camera", "light",
+                          "ground", "background", "size"})
       if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");
     if (const toml::table* t = r.table("channels")) {
       const std::vector<std::string> passes = pass_names();
@@ -373,7 +394,8 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
           cm.channels.push_back(*str);
         }
         if (int(cm.channels.size()) != info->count)
-          throw Error(m.key_path(pass), fmt::format("expected {}, got {}", expected, cm.channels.size()));
+          throw Error(m.key_path(pass),
+                      fmt::format("expected {}, got {}", expected, cm.channels.size()));
         s.channels.push_back(cm);
       }
     }
@@ -391,9 +413,11 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
         if (cm.pass == p.name) key = r.key_path("channels") + "." + p.name;
       for (const std::string& ch : want)
         if (std::find(have.begin(), have.end(), ch) == have.end())
-          throw Error(key, fmt::format("channel '{}' of pass '{}' is not in '{}'", ch, p.name, first));
+          throw Error(key,
+                      fmt::format("channel '{}' of pass '{}' is not in '{}'", ch, p.name, first));
     }
-    const AnyImage probe = read_image(first, ReadOptions{source_channels(s, *render::find_pass("alpha"))});
+    const AnyImage probe =
+        read_image(first, ReadOptions{source_channels(s, *render::find_pass("alpha"))});
     s.width = probe.width();
     s.height = probe.height();
   }
@@ -411,7 +435,8 @@ void parse_exemplar(Reader& r, Context& ctx, pipeline::Exemplar& e) {
     exemplar::ReferenceSpec& ref = e.reference;
     if (r.has("sphere")) {
       const std::vector<float> c = r.numbers("sphere", 3);
-      if (!(c[2] > 0.0f)) throw Error(r.key_path("sphere"), fmt::format("radius must be > 0, got {}", c[2]));
+      if (!(c[2] > 0.0f))
+        throw Error(r.key_path("sphere"), fmt::format("radius must be > 0, got {}", c[2]));
       ref.center = {c[0], c[1]};
       ref.radius = c[2];
     }
@@ -419,7 +444,8 @@ void parse_exemplar(Reader& r, Context& ctx, pipeline::Exemplar& e) {
     if (r.has("horizon")) ref.horizon_row = r.real("horizon", 0.0f);
     ref.fov_deg = r.real("fov", ref.fov_deg, 1.0, 120.0);
     ref.light.direction = r.vec3("light", ref.light.direction);
-    if (glm::length(ref.light.direction) == 0.0f) throw Error(r.key_path("light"), "must not be [0, 0, 0]");
+    if (glm::length(ref.light.direction) == 0.0f)
+      throw Error(r.key_path("light"), "must not be [0, 0, 0]");
     ref.light.softness_deg = r.real("softness", ref.light.softness_deg, 0.0, 45.0);
     ref.ground = r.boolean("ground", ref.ground);
     const composite::Color g = r.color("ground_color", {0.8f, 0.8f, 0.8f});
@@ -474,16 +500,18 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
   l.kind = r.choice("kind", "custom", {"base", "outline", "shadow", "custom"});
   const KindDefaults d = kind_defaults(l.kind);
   l.exemplar = r.string("exemplar", "");
-  if (l.exemplar.empty()) throw Error(r.key_path("exemplar"), "is required (an [exemplars.NAME] table)");
+  if (l.exemplar.empty())
+    throw Error(r.key_path("exemplar"), "is required (an [exemplars.NAME] table)");
   if (!shot.find_exemplar(l.exemplar)) {
     std::vector<std::string> names;
     for (const auto& e : shot.exemplars) names.push_back(e.name);
     const std::string near = closest_key(l.exemplar, names);
-    throw Error(r.key_path("exemplar"),
-                fmt::format("'{}' is not defined in [exemplars]{}", l.exemplar,
-                            near.empty() ? (names.empty() ? std::string(" (there are none)")
-                                                          : fmt::format(" (defined: {})", join(names)))
-                                         : fmt::format(" — did you mean '{}'?", near)));
+    throw Error(
+        r.key_path("exemplar"),
+        fmt::format("'{}' is not defined in [exemplars]{}", l.exemplar,
+                    near.empty() ? (names.empty() ? std::string(" (there are none)")
+                                                  : fmt::format(" (defined: {})", join(names)))
+                                 : fmt::format(" — did you mean '{}'?", near)));
   }
   l.guides = d.guides;
   if (const toml::table* t = r.table("guides")) {
@@ -492,12 +520,16 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
     l.guides.clear();
     // Guides keep the file's order so that results do not depend on how toml++ sorts keys.
     std::vector<std::pair<std::string, int>> order;
-    for (const auto& [k, v] : *t) order.emplace_back(std::string(k.str()), int(v.source().begin.line) * 10000 + int(v.source().begin.column));
-    std::stable_sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.second < b.second; });
+    for (const auto& [k, v] : *t)
+      order.emplace_back(std::string(k.str()),
+                         int(v.source().begin.line) * 10000 + int(v.source().begin.column));
+    std::stable_sort(order.begin(), order.end(),
+                     [](auto& a, auto& b) { return a.second < b.second; });
     for (const auto& [pass, line] : order) {
       if (pass == "motion" || pass == "alpha" || pass == "position" || pass == "depth")
-        throw Error(g.key_path(pass), "this pass does not mean the same on the exemplar and the shot; "
-                                      "use normal, diffuse, shadow, outline, albedo, ...");
+        throw Error(g.key_path(pass),
+                    "this pass does not mean the same on the exemplar and the shot; "
+                    "use normal, diffuse, shadow, outline, albedo, ...");
       l.guides.push_back({pass, g.real(pass, 1.0f, 0.0, 1000.0)});
     }
     if (l.guides.empty()) throw Error(r.key_path("guides"), "needs at least one pass");
@@ -505,10 +537,12 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
   if (l.guides.empty()) throw Error(r.key_path("guides"), "is required for a 'custom' layer");
   pipeline::SynthSpec& s = l.synth;
   s.patch_size = r.integer("patch_size", s.patch_size, 3, 31);
-  if (s.patch_size % 2 == 0) throw Error(r.key_path("patch_size"), fmt::format("must be odd, got {}", s.patch_size));
+  if (s.patch_size % 2 == 0)
+    throw Error(r.key_path("patch_size"), fmt::format("must be odd, got {}", s.patch_size));
   s.uniformity = r.real("uniformity", s.uniformity, 0.0, 1e6);
   s.pyramid_levels = r.integer("pyramid_levels", s.pyramid_levels, -1, 32);
-  if (s.pyramid_levels == 0) throw Error(r.key_path("pyramid_levels"), "must be >= 1, or -1 for automatic");
+  if (s.pyramid_levels == 0)
+    throw Error(r.key_path("pyramid_levels"), "must be >= 1, or -1 for automatic");
   s.search_vote_iters = r.integer("search_vote_iters", s.search_vote_iters, -1, 100);
   s.patch_match_iters = r.integer("patch_match_iters", s.patch_match_iters, -1, 100);
   s.seed = uint64_t(r.integer("seed", 1, 0));
@@ -542,7 +576,8 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
   if (const toml::node* n = r.node("color")) {
     if (n->is_string()) {
       const std::string c = r.choice("color", "albedo", {"albedo", "gradient"});
-      look.source = c == "albedo" ? composite::ColorSource::kAlbedo : composite::ColorSource::kGradient;
+      look.source =
+          c == "albedo" ? composite::ColorSource::kAlbedo : composite::ColorSource::kGradient;
     } else if (n->is_array()) {
       look.source = composite::ColorSource::kFlat;
       look.flat = r.color("color", look.flat);
@@ -560,13 +595,16 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
       std::vector<float> v;
       if (sa)
         for (const toml::node& e : *sa) {
-          if (auto i = e.value_exact<int64_t>()) v.push_back(float(*i));
-          else if (auto f = e.value_exact<double>()) v.push_back(float(*f));
+          if (auto i = e.value_exact<int64_t>())
+            v.push_back(float(*i));
+          else if (auto f = e.value_exact<double>())
+            v.push_back(float(*f));
         }
       if (!sa || v.size() != 4 || sa->size() != 4)
         throw Error(r.key_path("gradient"), fmt::format("expected {}", expected));
       for (float x : v)
-        if (x < 0.0f || x > 1.0f) throw Error(r.key_path("gradient"), fmt::format("values must be in [0, 1], got {}", x));
+        if (x < 0.0f || x > 1.0f)
+          throw Error(r.key_path("gradient"), fmt::format("values must be in [0, 1], got {}", x));
       if (!look.gradient.empty() && v[0] < look.gradient.back().position)
         throw Error(r.key_path("gradient"), "stops must be sorted by position");
       look.gradient.push_back({v[0], {v[1], v[2], v[3]}});
@@ -577,27 +615,34 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
   }
   if (look.source == composite::ColorSource::kGradient && look.gradient.empty())
     throw Error(r.key_path("gradient"), "is required with color = \"gradient\"");
-  const std::string alpha = r.choice("alpha",
-                                     look.alpha_from == composite::AlphaFrom::kInverseValue ? "inverse_value"
-                                     : look.alpha_from == composite::AlphaFrom::kValue ? "value"
-                                                                                       : "mask",
-                                     {"mask", "value", "inverse_value"});
+  const std::string alpha =
+      r.choice("alpha",
+               look.alpha_from == composite::AlphaFrom::kInverseValue ? "inverse_value"
+               : look.alpha_from == composite::AlphaFrom::kValue      ? "value"
+                                                                      : "mask",
+               {"mask", "value", "inverse_value"});
   look.alpha_from = alpha == "mask"    ? composite::AlphaFrom::kMask
                     : alpha == "value" ? composite::AlphaFrom::kValue
                                        : composite::AlphaFrom::kInverseValue;
-  const std::string blend_default = look.blend == composite::BlendMode::kMultiply ? "multiply" : "normal";
-  look.blend = parse_blend(r.choice("blend", blend_default, {"normal", "multiply", "screen", "overlay"}));
+  const std::string blend_default =
+      look.blend == composite::BlendMode::kMultiply ? "multiply" : "normal";
+  look.blend =
+      parse_blend(r.choice("blend", blend_default, {"normal", "multiply", "screen", "overlay"}));
   composite::Filters& f = look.filters;
   if (r.has("levels")) {
     const std::vector<float> v = r.numbers("levels", 3);
-    if (!(v[0] < v[1])) throw Error(r.key_path("levels"), fmt::format("black {} must be below white {}", v[0], v[1]));
-    if (!(v[2] > 0.0f)) throw Error(r.key_path("levels"), fmt::format("gamma must be > 0, got {}", v[2]));
+    if (!(v[0] < v[1]))
+      throw Error(r.key_path("levels"), fmt::format("black {} must be below white {}", v[0], v[1]));
+    if (!(v[2] > 0.0f))
+      throw Error(r.key_path("levels"), fmt::format("gamma must be > 0, got {}", v[2]));
     f.in_black = v[0], f.in_white = v[1], f.gamma = v[2];
   }
   if (r.has("output_levels")) {
     const std::vector<float> v = r.numbers("output_levels", 2);
     for (float x : v)
-      if (x < 0.0f || x > 1.0f) throw Error(r.key_path("output_levels"), fmt::format("values must be in [0, 1], got {}", x));
+      if (x < 0.0f || x > 1.0f)
+        throw Error(r.key_path("output_levels"),
+                    fmt::format("values must be in [0, 1], got {}", x));
     f.out_black = v[0], f.out_white = v[1];
   }
   f.tint = r.color("tint", f.tint);
@@ -610,8 +655,10 @@ void check_output_folder(const std::string& key, const std::string& folder) {
   std::error_code ec;
   fs::path p(folder);
   if (fs::exists(p, ec)) {
-    if (!fs::is_directory(p, ec)) throw Error(key, fmt::format("'{}' exists and is not a folder", folder));
-    if (::access(p.c_str(), W_OK | X_OK) != 0) throw Error(key, fmt::format("folder '{}' is not writable", folder));
+    if (!fs::is_directory(p, ec))
+      throw Error(key, fmt::format("'{}' exists and is not a folder", folder));
+    if (::access(p.c_str(), W_OK | X_OK) != 0)
+      throw Error(key, fmt::format("folder '{}' is not writable", folder));
     return;
   }
   // Not there yet: the nearest existing parent must let us create it.
@@ -619,10 +666,13 @@ void check_output_folder(const std::string& key, const std::string& folder) {
   while (!parent.empty() && !fs::exists(parent, ec)) parent = parent.parent_path();
   if (parent.empty()) parent = ".";
   if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK | X_OK) != 0)
-    throw Error(key, fmt::format("cannot create folder '{}': '{}' is not a writable folder", folder, parent.string()));
+    throw Error(key, fmt::format("cannot create folder '{}': '{}' is not a writable folder", folder,
+                                 parent.string()));
 }
 
-int declared_line(const toml::node& n) { return int(n.source().begin.line); }
+int declared_line(const toml::node& n) {
+  return int(n.source().begin.line);
+}
 
 }  // namespace
 
@@ -642,15 +692,16 @@ Shot parse_shot(std::string_view text, const std::string& path) {
 
   {
     Reader src(*top.table("source", true), "source",
-               {"scene", "sequence", "frames", "size", "fps", "clip", "start", "aa", "outline_width",
-                "crease", "camera", "light", "ground", "background", "channels"});
+               {"scene", "sequence", "frames", "size", "fps", "clip", "start", "aa",
+                "outline_width", "crease", "camera", "light", "ground", "background", "channels"});
     parse_source(src, ctx, shot.source);
   }
 
   const toml::table* exemplars = top.table("exemplars", true);
   {
     std::vector<std::pair<int, std::string>> names;
-    for (const auto& [k, v] : *exemplars) names.emplace_back(declared_line(v), std::string(k.str()));
+    for (const auto& [k, v] : *exemplars)
+      names.emplace_back(declared_line(v), std::string(k.str()));
     std::sort(names.begin(), names.end());
     for (const auto& [line, name] : names) {
       const toml::node* n = exemplars->get(name);
@@ -664,7 +715,8 @@ Shot parse_shot(std::string_view text, const std::string& path) {
       parse_exemplar(r, ctx, e);
       shot.exemplars.push_back(std::move(e));
     }
-    if (shot.exemplars.empty()) throw Error("exemplars", "needs at least one [exemplars.NAME] table");
+    if (shot.exemplars.empty())
+      throw Error("exemplars", "needs at least one [exemplars.NAME] table");
   }
 
   const toml::table* layers = top.table("layers", true);
@@ -678,13 +730,37 @@ Shot parse_shot(std::string_view text, const std::string& path) {
       if (!n->is_table()) throw Error(key, fmt::format("expected a table, got {}", type_name(*n)));
       for (char c : name)
         if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'))
-          throw Error(key, "layer names may use letters, digits, '_' and '-' only (they name files)");
+          throw Error(key,
+                      "layer names may use letters, digits, '_' and '-' only (they name files)");
       Reader r(*n->as_table(), key,
-               {"kind", "exemplar", "guides", "patch_size", "uniformity", "pyramid_levels",
-                "search_vote_iters", "patch_match_iters", "seed", "single_colour", "channel",
-                "temporal", "temporal_weight", "advection", "mask", "mask_dilate",
-                "mask_threshold", "order", "color", "gradient", "alpha", "blend", "levels",
-                "output_levels", "tint", "hue", "saturation", "opacity"});
+               {"kind",
+                "exemplar",
+                "guides",
+                "patch_size",
+                "uniformity",
+                "pyramid_levels",
+                "search_vote_iters",
+                "patch_match_iters",
+                "seed",
+                "single_colour",
+                "channel",
+                "temporal",
+                "temporal_weight",
+                "advection",
+                "mask",
+                "mask_dilate",
+                "mask_threshold",
+                "order",
+                "color",
+                "gradient",
+                "alpha",
+                "blend",
+                "levels",
+                "output_levels",
+                "tint",
+                "hue",
+                "saturation",
+                "opacity"});
       pipeline::Layer l;
       l.name = name;
       parse_layer(r, shot, l);
@@ -705,8 +781,8 @@ Shot parse_shot(std::string_view text, const std::string& path) {
   {
     const toml::table* t = top.table("outputs", true);
     Reader r(*t, "outputs",
-             {"folder", "layer_png", "composite_png", "composite_exr", "layered_exr",
-              "mp4", "contact_sheet", "crf"});
+             {"folder", "layer_png", "composite_png", "composite_exr", "layered_exr", "mp4",
+              "contact_sheet", "crf"});
     pipeline::Outputs& o = shot.outputs;
     const std::string folder = r.string("folder", "");
     if (folder.empty()) throw Error("outputs.folder", "is required");
@@ -719,7 +795,8 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     o.contact_sheet = r.boolean("contact_sheet", o.contact_sheet);
     o.crf = r.integer("crf", o.crf, 0, 51);
     if (o.mp4 && !o.composite_png)
-      throw Error("outputs.mp4", "is made from the composited PNG frames: needs composite_png = true");
+      throw Error("outputs.mp4",
+                  "is made from the composited PNG frames: needs composite_png = true");
     check_output_folder("outputs.folder", o.folder);
   }
   return shot;

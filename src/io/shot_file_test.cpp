@@ -35,11 +35,11 @@ TEST(ShotFile, EditDistance) {
 }
 
 TEST(ShotFile, KindsSetTheirDefaults) {
-  const pipeline::Shot s = parse_shot(
-      minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n"
-              "[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\n"
-              "[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"),
-      "/tmp/shot.toml");
+  const pipeline::Shot s =
+      parse_shot(minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n"
+                         "[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\n"
+                         "[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"),
+                 "/tmp/shot.toml");
   ASSERT_EQ(s.layers.size(), 3u);
   // File order is kept (toml++ sorts keys; the parser orders by line).
   EXPECT_EQ(s.layers[0].name, "base");
@@ -60,9 +60,10 @@ TEST(ShotFile, KindsSetTheirDefaults) {
 
 TEST(ShotFile, GuidesKeepTheFileOrderAndOrderSortsLayers) {
   const pipeline::Shot s = parse_shot(
-      minimal("[layers.top]\nexemplar = \"sphere\"\norder = 2\nguides = { shadow = 0.5, normal = 2 }\n"
-              "[layers.bottom]\nexemplar = \"sphere\"\norder = 1\nguides = { diffuse = 1 }\n"
-              "gradient = [[0, 0, 0, 0], [1, 1, 0.5, 0]]\n"),
+      minimal(
+          "[layers.top]\nexemplar = \"sphere\"\norder = 2\nguides = { shadow = 0.5, normal = 2 }\n"
+          "[layers.bottom]\nexemplar = \"sphere\"\norder = 1\nguides = { diffuse = 1 }\n"
+          "gradient = [[0, 0, 0, 0], [1, 1, 0.5, 0]]\n"),
       "/tmp/shot.toml");
   EXPECT_EQ(s.layers[0].name, "bottom");
   EXPECT_EQ(s.layers[1].guides[0].pass, "shadow");
@@ -73,15 +74,28 @@ TEST(ShotFile, GuidesKeepTheFileOrderAndOrderSortsLayers) {
 
 TEST(ShotFile, ErrorsNameTheKeyPath) {
   const std::string base = "[layers.outline]\nkind = \"outline\"\nexemplar = \"sphere\"\n";
-  EXPECT_EQ(error_of(minimal(base + "wieght = 1\n")).rfind("layers.outline.wieght: unknown key", 0), 0u);
-  EXPECT_NE(error_of(minimal(base + "temporal_wieght = 1\n")).find("did you mean 'temporal_weight'"),
-            std::string::npos);
-  EXPECT_EQ(error_of(minimal(base + "opacity = 2\n")).rfind("layers.outline.opacity: must be in [0, 1]", 0), 0u);
-  EXPECT_EQ(error_of(minimal(base + "levels = [0.5, 0.2, 1]\n")).rfind("layers.outline.levels:", 0), 0u);
-  EXPECT_EQ(error_of(minimal(base + "guides = { motion = 1 }\n")).rfind("layers.outline.guides.motion:", 0), 0u);
-  EXPECT_EQ(error_of(minimal(base + "gradient = [[0.5, 0, 0, 0], [0.1, 1, 1, 1]]\n")).rfind("layers.outline.gradient:", 0), 0u);
-  EXPECT_EQ(error_of(minimal("[layers.a]\nexemplar = \"sphere\"\n")).rfind("layers.a.guides: is required", 0), 0u);
-  EXPECT_EQ(error_of(minimal("[layers.\"bad name\"]\nkind = \"base\"\nexemplar = \"sphere\"\n")).rfind("layers.bad name:", 0), 0u);
+  EXPECT_EQ(error_of(minimal(base + "wieght = 1\n")).rfind("layers.outline.wieght: unknown key", 0),
+            0u);
+  EXPECT_NE(
+      error_of(minimal(base + "temporal_wieght = 1\n")).find("did you mean 'temporal_weight'"),
+      std::string::npos);
+  EXPECT_EQ(error_of(minimal(base + "opacity = 2\n"))
+                .rfind("layers.outline.opacity: must be in [0, 1]", 0),
+            0u);
+  EXPECT_EQ(error_of(minimal(base + "levels = [0.5, 0.2, 1]\n")).rfind("layers.outline.levels:", 0),
+            0u);
+  EXPECT_EQ(error_of(minimal(base + "guides = { motion = 1 }\n"))
+                .rfind("layers.outline.guides.motion:", 0),
+            0u);
+  EXPECT_EQ(error_of(minimal(base + "gradient = [[0.5, 0, 0, 0], [0.1, 1, 1, 1]]\n"))
+                .rfind("layers.outline.gradient:", 0),
+            0u);
+  EXPECT_EQ(error_of(minimal("[layers.a]\nexemplar = \"sphere\"\n"))
+                .rfind("layers.a.guides: is required", 0),
+            0u);
+  EXPECT_EQ(error_of(minimal("[layers.\"bad name\"]\nkind = \"base\"\nexemplar = \"sphere\"\n"))
+                .rfind("layers.bad name:", 0),
+            0u);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "io/shot_inputs.h"
 
+#include <fmt/format.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -7,8 +8,6 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "io/gltf_loader.h"
@@ -38,11 +37,13 @@ std::string frame_file(const std::string& pattern, int frame) {
   return out;
 }
 
-std::vector<std::string> source_channels(const pipeline::Source& source, const render::PassInfo& pass) {
+std::vector<std::string> source_channels(const pipeline::Source& source,
+                                         const render::PassInfo& pass) {
   for (const auto& m : source.channels)
     if (m.pass == pass.name) return m.channels;
   std::vector<std::string> names;
-  for (int c = 0; c < pass.count; ++c) names.push_back(fmt::format("{}.{}", pass.name, pass.suffixes[c]));
+  for (int c = 0; c < pass.count; ++c)
+    names.push_back(fmt::format("{}.{}", pass.name, pass.suffixes[c]));
   return names;
 }
 
@@ -93,7 +94,8 @@ Image<float> rgb_of(const std::string& key, const std::string& path) {
         for (int c = 0; c < 3; ++c) out(x, y, c) = img(x, y, 0);
     return out;
   }
-  throw Error(key, fmt::format("'{}' has {} channels; expected grey, RGB or RGBA", path, img.channels()));
+  throw Error(
+      key, fmt::format("'{}' has {} channels; expected grey, RGB or RGBA", path, img.channels()));
 }
 
 }  // namespace
@@ -133,7 +135,8 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
         for (const pipeline::GuideSpec& g : l.guides) {
           const render::PassInfo* p = render::find_pass(g.pass);
           std::vector<std::string> names;
-          for (int c = 0; c < p->count; ++c) names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
+          for (int c = 0; c < p->count; ++c)
+            names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
           for (const std::string& n : names)
             if (std::find(have.begin(), have.end(), n) == have.end())
               throw Error(key + ".passes",
@@ -141,9 +144,9 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
                                       g.pass, l.name, e.passes));
           const Image<float> pass = read_image_float(e.passes, ReadOptions{names});
           if (pass.width() != w || pass.height() != h)
-            throw Error(key + ".passes", fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}",
-                                                     e.passes, pass.width(), pass.height(),
-                                                     e.painting, w, h));
+            throw Error(key + ".passes",
+                        fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}", e.passes,
+                                    pass.width(), pass.height(), e.painting, w, h));
           for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x)
               for (int c = 0; c < p->count; ++c) im.passes(x, y, p->first + c) = pass(x, y, c);
@@ -157,7 +160,8 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
 
 pipeline::CompositeInputs load_composite_inputs(const Shot& shot) {
   pipeline::CompositeInputs ci;
-  if (!shot.compositing.paper.empty()) ci.paper = rgb_of("compositing.paper", shot.compositing.paper);
+  if (!shot.compositing.paper.empty())
+    ci.paper = rgb_of("compositing.paper", shot.compositing.paper);
   return ci;
 }
 
@@ -178,15 +182,20 @@ std::string OutputPaths::composite_exr(int frame) const {
 std::string OutputPaths::layered_exr(int frame) const {
   return fmt::format("{}/layered/frame_{:04d}.exr", folder, frame);
 }
-std::string OutputPaths::mp4() const { return folder + "/preview.mp4"; }
-std::string OutputPaths::contact_sheet() const { return folder + "/contact_sheet.png"; }
+std::string OutputPaths::mp4() const {
+  return folder + "/preview.mp4";
+}
+std::string OutputPaths::contact_sheet() const {
+  return folder + "/contact_sheet.png";
+}
 
 namespace {
 
 void make_folder(const fs::path& p) {
   std::error_code ec;
   fs::create_directories(p, ec);
-  if (!fs::is_directory(p, ec)) throw Error("outputs.folder", fmt::format("cannot create folder '{}'", p.string()));
+  if (!fs::is_directory(p, ec))
+    throw Error("outputs.folder", fmt::format("cannot create folder '{}'", p.string()));
 }
 
 // image_io writes ".<stem>.tmp<pid><ext>" and renames it; a killed run leaves those behind.
@@ -202,8 +211,10 @@ void remove_temporaries(const fs::path& dir) {
 
 std::vector<std::string> value_names(const std::string& prefix, int channels, int value_channels) {
   std::vector<std::string> n;
-  if (value_channels == 1) n.push_back(prefix + "Y");
-  else for (const char* c : {"R", "G", "B"}) n.push_back(prefix + c);
+  if (value_channels == 1)
+    n.push_back(prefix + "Y");
+  else
+    for (const char* c : {"R", "G", "B"}) n.push_back(prefix + c);
   if (channels > value_channels) n.push_back(prefix + "A");
   return n;
 }
@@ -305,11 +316,13 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
 
 void encode_mp4(const std::string& pattern, int first, float fps, int crf, const std::string& out) {
   const fs::path target(out);
-  const std::string tmp = (target.parent_path() / fmt::format(".{}.tmp{}.mp4", target.stem().string(), ::getpid())).string();
-  std::vector<std::string> args = {"ffmpeg", "-nostdin", "-y", "-loglevel", "error",
-                                   "-framerate", fmt::format("{}", fps), "-start_number",
-                                   std::to_string(first), "-i", pattern, "-c:v", "libx264",
-                                   "-pix_fmt", "yuv420p", "-crf", std::to_string(crf),
+  const std::string tmp =
+      (target.parent_path() / fmt::format(".{}.tmp{}.mp4", target.stem().string(), ::getpid()))
+          .string();
+  std::vector<std::string> args = {"ffmpeg", "-nostdin", "-y", "-loglevel", "error", "-framerate",
+                                   fmt::format("{}", fps), "-start_number", std::to_string(first),
+                                   "-i", pattern, "-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf",
+                                   std::to_string(crf),
                                    // yuv420p needs even sizes.
                                    "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", tmp};
   std::vector<char*> argv;

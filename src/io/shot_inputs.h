@@ -20,7 +20,8 @@ namespace emaki::io {
 std::string frame_file(const std::string& pattern, int frame);
 
 // The channel names a sequence source reads for `pass` (its mapping, or emaki's own names).
-std::vector<std::string> source_channels(const pipeline::Source& source, const render::PassInfo& pass);
+std::vector<std::string> source_channels(const pipeline::Source& source,
+                                         const render::PassInfo& pass);
 
 // The shot's frames. Errors name the shot file's keys (source.scene, source.clip, ...).
 std::unique_ptr<pipeline::FrameSource> open_frames(const pipeline::Shot& shot);

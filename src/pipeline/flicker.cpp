@@ -22,7 +22,7 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
       if (mask_channel >= 0 && cur(x, y, mask_channel) < 1.0f) continue;
       const float id = p[render::kObjectId];
       if (id < 1.0f) continue;
-      const float sx = x + p[render::kMotion] , sy = y + p[render::kMotion + 1];
+      const float sx = x + p[render::kMotion], sy = y + p[render::kMotion + 1];
       const int x0 = int(std::floor(sx)), y0 = int(std::floor(sy));
       if (x0 < 0 || y0 < 0 || x0 + 1 >= w || y0 + 1 >= h) continue;
       const float fx = sx - x0, fy = sy - y0;
@@ -31,7 +31,8 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
       for (int j = 0; j < 2 && ok; ++j)
         for (int i = 0; i < 2 && ok; ++i) {
           const float* q = pp.at(x0 + i, y0 + j);
-          if (q[render::kAlpha] < 1.0f || q[render::kObjectId] != id || q[render::kOutline] > 0.0f) ok = false;
+          if (q[render::kAlpha] < 1.0f || q[render::kObjectId] != id || q[render::kOutline] > 0.0f)
+            ok = false;
           if (mask_channel >= 0 && prev(x0 + i, y0 + j, mask_channel) < 1.0f) ok = false;
           v += (i ? fx : 1 - fx) * (j ? fy : 1 - fy) * prev(x0 + i, y0 + j, 0);
         }

@@ -1,9 +1,9 @@
 #include "pipeline/frames.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "exemplar/reference_sphere.h"
@@ -73,16 +73,28 @@ Image<float> layer_mask(ImageView<const float> passes, const MaskSpec& spec) {
       const float* p = passes.at(x, y);
       const bool covered = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 1.0f;
       // In shadow: cast shadow, or the surface turned away from the key light.
-      const bool shadowed = covered && (p[render::kShadow] > spec.threshold ||
-                                        p[render::kDiffuse] < 0.1f);
+      const bool shadowed =
+          covered && (p[render::kShadow] > spec.threshold || p[render::kDiffuse] < 0.1f);
       bool in = false;
       switch (spec.kind) {
-        case MaskKind::kNone: in = true; break;
-        case MaskKind::kCovered: in = covered; break;
-        case MaskKind::kObjects: in = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 2.0f; break;
-        case MaskKind::kLines: in = p[render::kOutline] > spec.threshold; break;
-        case MaskKind::kShadow: in = shadowed; break;
-        case MaskKind::kLit: in = covered && !shadowed; break;
+        case MaskKind::kNone:
+          in = true;
+          break;
+        case MaskKind::kCovered:
+          in = covered;
+          break;
+        case MaskKind::kObjects:
+          in = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 2.0f;
+          break;
+        case MaskKind::kLines:
+          in = p[render::kOutline] > spec.threshold;
+          break;
+        case MaskKind::kShadow:
+          in = shadowed;
+          break;
+        case MaskKind::kLit:
+          in = covered && !shadowed;
+          break;
       }
       m(x, y) = in ? 1.0f : 0.0f;
     }

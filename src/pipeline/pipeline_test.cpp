@@ -28,7 +28,10 @@ class SlidingFrames : public FrameSource {
         o[render::kNormal] = u;
         o[render::kNormal + 1] = v;
         o[render::kNormal + 2] = 0.5f;
-        for (int c = 0; c < 3; ++c) o[render::kPositionNorm + c] = o[render::kRestPosition + c] = c == 0 ? u : c == 1 ? v : 0.5f;
+        for (int c = 0; c < 3; ++c)
+          o[render::kPositionNorm + c] = o[render::kRestPosition + c] = c == 0   ? u
+                                                                        : c == 1 ? v
+                                                                                 : 0.5f;
         o[render::kDiffuse] = 0.5f + 0.5f * std::sin(6.0f * u);
         o[render::kAlbedo] = o[render::kAlbedo + 1] = o[render::kAlbedo + 2] = 0.5f;
         o[render::kObjectId] = 2.0f;
@@ -53,7 +56,8 @@ class MemoryStore : public Store {
   }
   void write_layer(const Layer& l, int f, ImageView<const float> v) override {
     Image<float> img(v.width, v.height, v.channels);
-    for (int y = 0; y < v.height; ++y) std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
+    for (int y = 0; y < v.height; ++y)
+      std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
     layers[{l.name, f}] = std::move(img);
   }
   bool has_frame(int f) const override { return frames.count(f) > 0; }
@@ -91,7 +95,8 @@ std::map<std::string, ExemplarImages> tiny_exemplar() {
   ex.painting = Image<float>(36, 28, 3);
   for (int y = 0; y < 28; ++y)
     for (int x = 0; x < 36; ++x)
-      for (int c = 0; c < 3; ++c) ex.painting(x, y, c) = 0.5f + 0.4f * std::sin(0.9f * x + 0.4f * y + c);
+      for (int c = 0; c < 3; ++c)
+        ex.painting(x, y, c) = 0.5f + 0.4f * std::sin(0.9f * x + 0.4f * y + c);
   std::map<std::string, ExemplarImages> m;
   m.emplace("ex", std::move(ex));
   return m;
@@ -177,7 +182,7 @@ TEST(Pipeline, TemporalGuideChangesFramesAfterTheFirst) {
     const Image<float>& b = without.layers.at({"base", f});
     return std::memcmp(a.row(0), b.row(0), a.bytes()) == 0;
   };
-  EXPECT_TRUE(same(0));   // the first frame has no temporal guide
+  EXPECT_TRUE(same(0));  // the first frame has no temporal guide
   EXPECT_FALSE(same(2));
 }
 
@@ -187,10 +192,11 @@ TEST(Pipeline, ColourLayerTransfersRgbWithItsMask) {
   shot.layers[0].mask = {MaskKind::kLines, 3.0f, 0.5f};
   const SlidingFrames frames(40, 30);
   MemoryStore store;
-  const RunReport r = run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, store, RunOptions{});
+  const RunReport r =
+      run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, store, RunOptions{});
   EXPECT_EQ(r.synthesized, 4);
   const Image<float>& v = store.layers.at({"base", 2});
-  ASSERT_EQ(v.channels(), 4);  // RGB + mask coverage
+  ASSERT_EQ(v.channels(), 4);     // RGB + mask coverage
   EXPECT_EQ(v(21, 10, 3), 1.0f);  // the line sits at x = 20 + 2 in frame 2
   EXPECT_EQ(v(5, 10, 3), 0.0f);
   EXPECT_NE(v(21, 10, 0), v(21, 10, 2));  // colours, not one touch
@@ -220,7 +226,7 @@ TEST(Pipeline, ContactSheetGrid) {
   EXPECT_EQ(sheet.width(), 4 * 40 + 5 * 4);
   EXPECT_EQ(sheet.height(), 2 * 20 + 3 * 4);
   EXPECT_FLOAT_EQ(sheet(4 + 40 + 4 + 10, 4 + 10, 0), 0.1f);  // second thumbnail
-  EXPECT_FLOAT_EQ(sheet(4 + 10, 4 + 20 + 4 + 10, 0), 0.4f);   // fifth, second row
+  EXPECT_FLOAT_EQ(sheet(4 + 10, 4 + 20 + 4 + 10, 0), 0.4f);  // fifth, second row
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
 #include "pipeline/run.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
-
-#include <fmt/format.h>
 
 #include "composite/composite.h"
 #include "core/error.h"
@@ -39,7 +39,8 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex) {
                   "false needs an RGB painting, its exemplar's painting is grey");
     p.style = extract(ex.painting.cview(), 0, 3);
   }
-  for (const GuideSpec& g : layer.guides) p.source_guides.push_back(extract_pass(ex.passes.cview(), g.pass));
+  for (const GuideSpec& g : layer.guides)
+    p.source_guides.push_back(extract_pass(ex.passes.cview(), g.pass));
   return p;
 }
 
@@ -83,7 +84,8 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
   for (std::size_t i = 0; i < l.guides.size(); ++i) {
     targets.push_back(extract_pass(passes, l.guides[i].pass));
     inputs.guides.push_back({fmt::format("layers.{}.guides.{}", l.name, l.guides[i].pass),
-                             p.source_guides[i].cview(), targets.back().cview(), l.guides[i].weight});
+                             p.source_guides[i].cview(), targets.back().cview(),
+                             l.guides[i].weight});
   }
   Image<float> advected;
   if (previous && previous_passes) {
@@ -94,7 +96,8 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
     a.value_channels = n;
     a.previous_guide = guide_prev.cview();
     a.current_guide = guide_cur.cview();
-    a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
+    a.guide_name =
+        l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
     if (!mask.empty()) a.current_mask = mask.cview();
     advected = temporal::advect(a, synth_params(l.synth, frame_seed(l, frame, 1)));
     inputs.guides.push_back({fmt::format("layers.{}.temporal", l.name), p.style.cview(),
@@ -229,7 +232,8 @@ RunReport run_shot(const Shot& shot, const FrameSource& frames,
         previous_passes = &prev_passes.value;
       }
       tick(f, l.name);
-      now[i].value = synthesize_layer(prepared[i], get_passes().cview(), f, previous, previous_passes);
+      now[i].value =
+          synthesize_layer(prepared[i], get_passes().cview(), f, previous, previous_passes);
       store.write_layer(l, f, now[i].value.cview());
       ++report.synthesized;
       changed = true;
@@ -274,8 +278,9 @@ int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInpu
     std::vector<Image<float>> values;
     for (const Layer& l : shot.layers) {
       if (!store.has_layer(l, f))
-        throw Error(fmt::format("layers.{}", l.name),
-                    fmt::format("frame {} has not been synthesized yet (run `emaki run` first)", f));
+        throw Error(
+            fmt::format("layers.{}", l.name),
+            fmt::format("frame {} has not been synthesized yet (run `emaki run` first)", f));
       values.push_back(store.read_layer(l, f));
     }
     std::vector<ImageView<const float>> views;

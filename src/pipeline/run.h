@@ -42,7 +42,7 @@ class Store {
 
 struct Progress {
   int frame = 0;
-  std::string layer;    // empty: compositing
+  std::string layer;        // empty: compositing
   int done = 0, total = 0;  // layer-frames synthesized so far / to synthesize in this run
   double elapsed_s = 0.0;
 };
@@ -55,9 +55,9 @@ struct RunOptions {
 };
 
 struct RunReport {
-  int synthesized = 0;  // layer-frames synthesized
-  int reused = 0;       // layer-frames read back (finished before)
-  int composited = 0;   // frames composited
+  int synthesized = 0;                  // layer-frames synthesized
+  int reused = 0;                       // layer-frames read back (finished before)
+  int composited = 0;                   // frames composited
   int first_frame = 0, last_frame = 0;  // frames visited (the chain may start before --frames)
 };
 

@@ -32,10 +32,10 @@ struct Source {
   float fps = 24.0f;
   // kScene
   std::string scene_path;
-  scene::ShotSpec shot;           // camera, light, ground, clip; frames mirror first/last_frame
-  render::RenderOptions render;   // width/height mirror the source's size
+  scene::ShotSpec shot;          // camera, light, ground, clip; frames mirror first/last_frame
+  render::RenderOptions render;  // width/height mirror the source's size
   // kSequence
-  std::string pattern;            // printf-style with one integer, e.g. renders/frame_%04d.exr
+  std::string pattern;  // printf-style with one integer, e.g. renders/frame_%04d.exr
   std::vector<ChannelMapping> channels;  // passes read under other names than emaki's
 };
 
@@ -49,8 +49,8 @@ struct Exemplar {
   ExemplarKind kind = ExemplarKind::kMatcap;
   std::string painting;
   exemplar::ReferenceSpec reference;  // kMatcap; width/height come from the painting
-  int aa = 3;                          // kMatcap: supersampling of the reference passes
-  std::string passes;                  // kKeyframe: multilayer EXR with emaki's channel names
+  int aa = 3;                         // kMatcap: supersampling of the reference passes
+  std::string passes;                 // kKeyframe: multilayer EXR with emaki's channel names
 };
 
 struct GuideSpec {
@@ -118,13 +118,13 @@ struct Outputs {
   std::string folder;
   // layers/<layer>/<layer>_%04d.exr (float value + mask) is always written: resuming and
   // `emaki composite` read it.
-  bool layer_png = true;      // layers/<layer>/<layer>_%04d.png, 16-bit
-  bool composite_png = true;  // composite/frame_%04d.png, 16-bit
-  bool composite_exr = false; // composite/frame_%04d.exr
-  bool layered_exr = true;    // layered/frame_%04d.exr: every layer and pass
-  bool mp4 = true;            // preview.mp4 (ffmpeg, libx264)
-  bool contact_sheet = true;  // contact_sheet.png
-  int crf = 20;               // libx264 quality, [0, 51]
+  bool layer_png = true;       // layers/<layer>/<layer>_%04d.png, 16-bit
+  bool composite_png = true;   // composite/frame_%04d.png, 16-bit
+  bool composite_exr = false;  // composite/frame_%04d.exr
+  bool layered_exr = true;     // layered/frame_%04d.exr: every layer and pass
+  bool mp4 = true;             // preview.mp4 (ffmpeg, libx264)
+  bool contact_sheet = true;   // contact_sheet.png
+  int crf = 20;                // libx264 quality, [0, 51]
 };
 
 struct Shot {

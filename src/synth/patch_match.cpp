@@ -66,10 +66,10 @@ class DeltaPool {
 struct Sweep {
   const PatchMatchLevel& L;
   const PatchMatchConfig& C;
-  const int32_t* occ;        // snapshot window sums, sw x sh
-  const Image<int32_t>& snap;  // rows next to band edges as they were when the sweep began
+  const int32_t* occ;                 // snapshot window sums, sw x sh
+  const Image<int32_t>& snap;         // rows next to band edges as they were when the sweep began
   const std::vector<int>& snap_slot;  // target row -> row of snap (-1: not kept)
-  float occ_scale;           // uniformity / (p^2 * omega_best)
+  float occ_scale;                    // uniformity / (p^2 * omega_best)
   int r;
   std::ptrdiff_t src_stride, tgt_stride;
   int row_elems;
@@ -95,8 +95,10 @@ inline float occupancy(const Sweep& S, const Band& band, int cx, int cy) {
 
 void mark_dirty(Band& band, int sw, int sh, int cx, int cy, int p) {
   const int reach = p - 1;
-  const int bx0 = std::max(0, cx - reach) >> kDirtyShift, bx1 = std::min(sw - 1, cx + reach) >> kDirtyShift;
-  const int by0 = std::max(0, cy - reach) >> kDirtyShift, by1 = std::min(sh - 1, cy + reach) >> kDirtyShift;
+  const int bx0 = std::max(0, cx - reach) >> kDirtyShift,
+            bx1 = std::min(sw - 1, cx + reach) >> kDirtyShift;
+  const int by0 = std::max(0, cy - reach) >> kDirtyShift,
+            by1 = std::min(sh - 1, cy + reach) >> kDirtyShift;
   for (int by = by0; by <= by1; ++by)
     for (int bx = bx0; bx <= bx1; ++bx) band.dirty[by * band.dirty_stride + bx] = 1;
 }
@@ -167,7 +169,7 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
   // Random candidates are drawn one pixel ahead, around that pixel's match as the sweep found
   // it, and their patches prefetched, so their memory latency overlaps this pixel's work.
   int cand[2][32][2];
-  auto draw = [&](int x, int y, int (*out)[2]) {
+  auto draw = [&](int x, int y, int(*out)[2]) {
     const int32_t* n = L.nnf->at(x, y);
     CounterRng rng(hash_key(S.C.seed, uint64_t(iter), uint64_t(y) * 65536u + uint64_t(x)));
     for (int k = 0; k < num_radii; ++k) {
@@ -276,7 +278,8 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
     for (int x = 0; x < L.tw; ++x) active_count += is_active(L, x, y) ? 1 : 0;
   if (active_count == 0) return;
   const double omega_best = double(active_count) / (double(L.sw) * L.sh) * p * p;
-  const float occ_scale = C.uniformity > 0.0f ? float(C.uniformity / (double(p) * p * omega_best)) : 0.0f;
+  const float occ_scale =
+      C.uniformity > 0.0f ? float(C.uniformity / (double(p) * p * omega_best)) : 0.0f;
 
   const int dirty_stride = (L.sw >> kDirtyShift) + 1;
   DeltaPool pool(std::size_t(L.sw) * L.sh, std::size_t(dirty_stride) * ((L.sh >> kDirtyShift) + 1));
@@ -293,11 +296,23 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   std::vector<int32_t> occ, occ_scratch;
   for (int iter = 0; iter < C.iterations; ++iter) {
     for (std::size_t k = 0; k < snap_rows.size(); ++k)
-      std::memcpy(snap.row(int(k)), L.nnf->row(snap_rows[k]), std::size_t(L.tw) * 2 * sizeof(int32_t));
-    if (occ_scale > 0.0f) occupancy_window_sums(L, p, occ, occ_scratch);
-    else occ.assign(std::size_t(L.sw) * L.sh, 0);
-    const Sweep sweep{L, C, occ.data(), snap, snap_slot, occ_scale, p / 2, L.src->stride(), L.tgt->stride(),
-                      p * L.src->channels(), 1.0 / C.err_scale};
+      std::memcpy(snap.row(int(k)), L.nnf->row(snap_rows[k]),
+                  std::size_t(L.tw) * 2 * sizeof(int32_t));
+    if (occ_scale > 0.0f)
+      occupancy_window_sums(L, p, occ, occ_scratch);
+    else
+      occ.assign(std::size_t(L.sw) * L.sh, 0);
+    const Sweep sweep{L,
+                      C,
+                      occ.data(),
+                      snap,
+                      snap_slot,
+                      occ_scale,
+                      p / 2,
+                      L.src->stride(),
+                      L.tgt->stride(),
+                      p * L.src->channels(),
+                      1.0 / C.err_scale};
     parallel_rows(L.th, band, [&](int y0, int y1) {
       Band band;
       auto buf = pool.take();

@@ -1,7 +1,7 @@
 // PatchMatch with EbSynth's occupancy-based uniformity term, made deterministic.
 //
-// The target is swept in bands whose height depends only on its size, in parallel. Inside a band the
-// sweep propagates as usual; across a band edge it reads the field as it was when the sweep
+// The target is swept in bands whose height depends only on its size, in parallel. Inside a band
+// the sweep propagates as usual; across a band edge it reads the field as it was when the sweep
 // began. Occupancy — how many target patches already cover a source patch — is kept as a
 // snapshot taken at the start of each sweep plus a band-private delta. Nothing a band reads is
 // written by another band, so the field is the same for any thread count and schedule.
@@ -10,8 +10,8 @@
 // histogram), so a candidate's occupancy costs one lookup instead of patch_size^2.
 #pragma once
 
-#include <cstdint>
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "core/image.h"
@@ -24,13 +24,15 @@ namespace emaki::synth {
 // next sweep); measured on StyLit, 8 bands score as well as one sequential sweep.
 inline constexpr int kBands = 8;
 inline constexpr int kMinBandRows = 16;
-inline int band_rows(int height) { return std::max(kMinBandRows, (height + kBands - 1) / kBands); }
+inline int band_rows(int height) {
+  return std::max(kMinBandRows, (height + kBands - 1) / kBands);
+}
 
 struct PatchMatchLevel {
   int sw = 0, sh = 0, tw = 0, th = 0;
-  int border = 0;  // padding of tgt
-  const Image<int16_t>* src = nullptr;  // sw x sh features
-  const Image<int16_t>* tgt = nullptr;  // (tw + 2 border) x (th + 2 border) features
+  int border = 0;                          // padding of tgt
+  const Image<int16_t>* src = nullptr;     // sw x sh features
+  const Image<int16_t>* tgt = nullptr;     // (tw + 2 border) x (th + 2 border) features
   const Image<uint8_t>* active = nullptr;  // tw x th, or empty: all active
   Image<int32_t>* nnf = nullptr;           // tw x th x 2
   Image<float>* err = nullptr;             // tw x th
@@ -55,7 +57,7 @@ void run_patch_match(const PatchMatchLevel& level, const PatchMatchConfig& confi
 // Occupancy summed over the patch window of each source centre, sw * sh values row by row
 // (exposed for tests).
 // `scratch` is a work buffer; both are resized as needed (reused across sweeps).
-void occupancy_window_sums(const PatchMatchLevel& level, int patch_size,
-                           std::vector<int32_t>& sums, std::vector<int32_t>& scratch);
+void occupancy_window_sums(const PatchMatchLevel& level, int patch_size, std::vector<int32_t>& sums,
+                           std::vector<int32_t>& scratch);
 
 }  // namespace emaki::synth

@@ -33,13 +33,15 @@ struct ChannelMap {
 struct FeatureLayout {
   int style_channels = 0;
   int guide_channels = 0;
-  int channels = 0;  // padded to a multiple of 8
+  int channels = 0;             // padded to a multiple of 8
   std::vector<ChannelMap> map;  // style then guide channels
   double err_scale = 1.0;       // EbSynth error = err_scale * sum of squared q differences
 };
 
 // Output size of one halving step.
-inline int half_size(int n) { return (n + 1) / 2; }
+inline int half_size(int n) {
+  return (n + 1) / 2;
+}
 
 // Low-pass and halve (any channel count). Integer types round to nearest.
 Image<float> downsample(ImageView<const float> in);
@@ -51,7 +53,8 @@ template <typename T>
 void decimate_channels(ImageView<const T> in, Image<T>& out, int c0, int c1) {
   for (int y = 0; y < out.height(); ++y)
     for (int x = 0; x < out.width(); ++x)
-      for (int c = c0; c < c1; ++c) out(x, y, c) = in(std::min(2 * x, in.width - 1), std::min(2 * y, in.height - 1), c);
+      for (int c = c0; c < c1; ++c)
+        out(x, y, c) = in(std::min(2 * x, in.width - 1), std::min(2 * y, in.height - 1), c);
 }
 // A mask halves to "any child inside".
 Image<uint8_t> downsample_mask(ImageView<const uint8_t> in);

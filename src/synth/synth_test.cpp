@@ -65,8 +65,8 @@ TEST(PatchDistance, Avx2EqualsScalar) {
         for (auto& v : b) v = int16_t(rng.uniform(kQuantMax + 1));
         if (trial == 0) std::fill(a.begin(), a.end(), int16_t(kQuantMax));  // worst case
         if (trial == 0) std::fill(b.begin(), b.end(), int16_t(0));
-        const int64_t full = patch_ssd_scalar(a.data(), stride, b.data(), stride, row_elems,
-                                              patch, std::numeric_limits<int64_t>::max());
+        const int64_t full = patch_ssd_scalar(a.data(), stride, b.data(), stride, row_elems, patch,
+                                              std::numeric_limits<int64_t>::max());
         const int64_t bound = trial % 2 ? full / 3 : std::numeric_limits<int64_t>::max();
         EXPECT_EQ(patch_ssd_scalar(a.data(), stride, b.data(), stride, row_elems, patch, bound),
                   patch_ssd_avx2(a.data(), stride, b.data(), stride, row_elems, patch, bound))

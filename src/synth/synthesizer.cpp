@@ -1,8 +1,9 @@
 #include "synth/synthesizer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -29,13 +30,18 @@ int plane_channels(const Plane& p) {
 
 namespace {
 
-bool is_float(const Plane& p) { return p.index() == 2; }
+bool is_float(const Plane& p) {
+  return p.index() == 2;
+}
 
 template <typename T>
 inline float norm(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>) return float(v) * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>) return float(v) * (1.0f / 65535.0f);
-  else return float(v);
+  if constexpr (std::is_same_v<T, uint8_t>)
+    return float(v) * (1.0f / 255.0f);
+  else if constexpr (std::is_same_v<T, uint16_t>)
+    return float(v) * (1.0f / 65535.0f);
+  else
+    return float(v);
 }
 
 // Calls fn(x, y, const float* values) per row as normalised floats.
@@ -121,9 +127,9 @@ void validate(const Inputs& in, const Params& p) {
       tw = plane_width(g.target), th = plane_height(g.target);
       first_target = g.name;
     } else if (plane_width(g.target) != tw || plane_height(g.target) != th) {
-      throw Error(g.name, fmt::format("target guide is {}x{} but '{}' is {}x{}",
-                                      plane_width(g.target), plane_height(g.target), first_target,
-                                      tw, th));
+      throw Error(g.name,
+                  fmt::format("target guide is {}x{} but '{}' is {}x{}", plane_width(g.target),
+                              plane_height(g.target), first_target, tw, th));
     }
     const int cs = plane_channels(g.source), ct = plane_channels(g.target);
     if (cs != ct)
@@ -143,9 +149,9 @@ void validate(const Inputs& in, const Params& p) {
                                           p.patch_size, p.patch_size));
   if (in.target_mask) {
     if (plane_width(*in.target_mask) != tw || plane_height(*in.target_mask) != th)
-      throw Error(in.target_mask_name, fmt::format("mask is {}x{} but the target is {}x{}",
-                                                   plane_width(*in.target_mask),
-                                                   plane_height(*in.target_mask), tw, th));
+      throw Error(in.target_mask_name,
+                  fmt::format("mask is {}x{} but the target is {}x{}", plane_width(*in.target_mask),
+                              plane_height(*in.target_mask), tw, th));
     check_finite(*in.target_mask, in.target_mask_name);
   }
 }
@@ -169,10 +175,14 @@ std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
   // enough for StyLit but not for FaceStyle's joint energy.)
   for (int l = 0; l < levels; ++l) {
     const int from_finest = levels - 1 - l;
-    if (from_finest == 0) s[l] = {2, 2, 32};
-    else if (from_finest == 1) s[l] = {2, 3, 32};
-    else if (from_finest == 2) s[l] = {3, 3, 0};
-    else s[l] = {6, 4, 0};
+    if (from_finest == 0)
+      s[l] = {2, 2, 32};
+    else if (from_finest == 1)
+      s[l] = {2, 3, 32};
+    else if (from_finest == 2)
+      s[l] = {3, 3, 0};
+    else
+      s[l] = {6, 4, 0};
   }
   return s;
 }
@@ -184,11 +194,11 @@ namespace {
 
 struct Level {
   int sw = 0, sh = 0, tw = 0, th = 0;
-  Image<int16_t> src;       // sw x sh features
-  Image<int16_t> tgt;       // padded target features
-  Image<float> src_style;   // sw x sh style values for voting (coarse levels; the finest
-                            // votes from the input itself)
-  Image<uint8_t> active;    // tw x th, or empty
+  Image<int16_t> src;      // sw x sh features
+  Image<int16_t> tgt;      // padded target features
+  Image<float> src_style;  // sw x sh style values for voting (coarse levels; the finest
+                           // votes from the input itself)
+  Image<uint8_t> active;   // tw x th, or empty
 };
 
 FeatureLayout make_layout(const Inputs& in, const Params& p) {
@@ -229,7 +239,8 @@ FeatureLayout make_layout(const Inputs& in, const Params& p) {
   for (int c = 0; c < n; ++c) {
     ChannelMap m;
     m.lo = range[c].first;
-    m.mult = float(kQuantMax * std::sqrt(double(w[c]) / w_max) / (range[c].second - range[c].first));
+    m.mult =
+        float(kQuantMax * std::sqrt(double(w[c]) / w_max) / (range[c].second - range[c].first));
     L.map.push_back(m);
   }
   L.err_scale = 65025.0 * w_max / (double(kQuantMax) * kQuantMax);
@@ -269,8 +280,8 @@ Image<int32_t> upscale_nnf(const Image<int32_t>& coarse, int tw, int th, int sw,
   parallel_rows(th, 64, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < tw; ++x) {
-        const int32_t* m = coarse.at(std::min(x / 2, coarse.width() - 1),
-                                     std::min(y / 2, coarse.height() - 1));
+        const int32_t* m =
+            coarse.at(std::min(x / 2, coarse.width() - 1), std::min(y / 2, coarse.height() - 1));
         out(x, y, 0) = std::clamp(2 * m[0] + (x & 1), r, sw - r - 1);
         out(x, y, 1) = std::clamp(2 * m[1] + (y & 1), r, sh - r - 1);
       }
@@ -304,7 +315,8 @@ struct Synthesizer::State {
 
 Synthesizer::~Synthesizer() = default;
 
-Synthesizer::Synthesizer(const Inputs& in, const Params& params) : state_(std::make_unique<State>()) {
+Synthesizer::Synthesizer(const Inputs& in, const Params& params)
+    : state_(std::make_unique<State>()) {
   validate(in, params);
   State& st = *state_;
   st.params = params;
@@ -387,7 +399,8 @@ Result Synthesizer::run(const OutputRequest& request) {
       for_each_row(st.style, 0, st.sh, [&](int y, const float* row) {
         if (y % 2 != 0 || y / 2 >= c.src_style.height()) return;
         for (int x = 0; x < c.src_style.width(); ++x)
-          for (int k = 0; k < ns; ++k) c.src_style(x, y / 2, k) = row[std::min(2 * x, st.sw - 1) * ns + k];
+          for (int k = 0; k < ns; ++k)
+            c.src_style(x, y / 2, k) = row[std::min(2 * x, st.sw - 1) * ns + k];
       });
     } else {
       decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
@@ -396,7 +409,8 @@ Result Synthesizer::run(const OutputRequest& request) {
     c.sw = c.src.width(), c.sh = c.src.height(), c.tw = t.width(), c.th = t.height();
     c.tgt.reset(c.tw + 2 * border, c.th + 2 * border, layout.channels);
     for (int y = 0; y < c.th; ++y)
-      std::copy(t.row(y), t.row(y) + std::size_t(c.tw) * layout.channels, c.tgt.at(border, y + border));
+      std::copy(t.row(y), t.row(y) + std::size_t(c.tw) * layout.channels,
+                c.tgt.at(border, y + border));
     pad_replicate(c.tgt, border, ns, layout.channels);
     if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
   }
@@ -430,8 +444,10 @@ Result Synthesizer::run(const OutputRequest& request) {
   for (int l = levels - 1; l >= 0; --l) {
     Level& L = pyr[l];
     if (params.progress) params.progress(levels - 1 - l, levels);
-    if (l == levels - 1) nnf = random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
-    else nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
+    if (l == levels - 1)
+      nnf = random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
+    else
+      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
     err.reset(L.tw, L.th, 1);
     vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
     write_style(style, layout, L.tgt, border);

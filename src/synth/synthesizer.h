@@ -27,17 +27,18 @@
 namespace emaki::synth {
 
 // A read-only input plane: 8-bit and 16-bit samples mean [0, 1]; float samples are taken as-is.
-using Plane = std::variant<ImageView<const uint8_t>, ImageView<const uint16_t>, ImageView<const float>>;
+using Plane =
+    std::variant<ImageView<const uint8_t>, ImageView<const uint16_t>, ImageView<const float>>;
 
 int plane_width(const Plane& p);
 int plane_height(const Plane& p);
 int plane_channels(const Plane& p);
 
 struct GuidePair {
-  std::string name;     // shown in error messages (a file name, a pass name)
-  Plane source;         // A_k, the size of the style exemplar
-  Plane target;         // B_k, the size of the output
-  float weight = -1.0f; // >= 0; negative: 1 / number of guides (EbSynth's default)
+  std::string name;      // shown in error messages (a file name, a pass name)
+  Plane source;          // A_k, the size of the style exemplar
+  Plane target;          // B_k, the size of the output
+  float weight = -1.0f;  // >= 0; negative: 1 / number of guides (EbSynth's default)
 };
 
 enum class VoteMode {
@@ -70,7 +71,7 @@ struct Params {
 };
 
 struct Inputs {
-  Plane style;                    // A', 1 to 4 channels
+  Plane style;  // A', 1 to 4 channels
   std::string style_name = "style";
   std::vector<GuidePair> guides;  // at least one
   // Optional target mask (first channel, > 0.5 is inside). Pixels outside are not synthesized
@@ -85,9 +86,9 @@ struct OutputRequest {
 };
 
 struct Result {
-  Image<float> image;    // B': style channels, plus alpha when a mask was given
-  Image<int32_t> nnf;    // when requested; (-1, -1) outside the mask
-  Image<float> error;    // when requested; 0 outside the mask
+  Image<float> image;  // B': style channels, plus alpha when a mask was given
+  Image<int32_t> nnf;  // when requested; (-1, -1) outside the mask
+  Image<float> error;  // when requested; 0 outside the mask
   int pyramid_levels = 0;
   std::vector<LevelSchedule> schedule;
 };

@@ -12,9 +12,12 @@ namespace {
 // Integer samples are summed as they are and scaled once at the end.
 template <typename T>
 constexpr double sample_scale() {
-  if constexpr (std::is_same_v<T, uint8_t>) return 1.0 / 255.0;
-  else if constexpr (std::is_same_v<T, uint16_t>) return 1.0 / 65535.0;
-  else return 1.0;
+  if constexpr (std::is_same_v<T, uint8_t>)
+    return 1.0 / 255.0;
+  else if constexpr (std::is_same_v<T, uint16_t>)
+    return 1.0 / 65535.0;
+  else
+    return 1.0;
 }
 
 template <int NC, typename T>
@@ -70,10 +73,18 @@ void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image
   });
   parallel_rows(th, 16, [&](int y0, int y1) {
     switch (nc) {
-      case 1: vote_rows<1>(source, nnf, weight, active, r, out, y0, y1); break;
-      case 2: vote_rows<2>(source, nnf, weight, active, r, out, y0, y1); break;
-      case 3: vote_rows<3>(source, nnf, weight, active, r, out, y0, y1); break;
-      default: vote_rows<4>(source, nnf, weight, active, r, out, y0, y1); break;
+      case 1:
+        vote_rows<1>(source, nnf, weight, active, r, out, y0, y1);
+        break;
+      case 2:
+        vote_rows<2>(source, nnf, weight, active, r, out, y0, y1);
+        break;
+      case 3:
+        vote_rows<3>(source, nnf, weight, active, r, out, y0, y1);
+        break;
+      default:
+        vote_rows<4>(source, nnf, weight, active, r, out, y0, y1);
+        break;
     }
   });
 }
