@@ -143,7 +143,7 @@ void check_output_path(const std::string& opt, const std::string& path) {
   try {
     io::check_writable(path);
   } catch (const Error& e) {
-    throw Error(opt + " " + path, std::string(e.what()).substr(path.size() + 2));
+    throw Error(opt, e.what());  // "-output: PATH: why"
   }
 }
 

@@ -52,7 +52,7 @@ int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t*
       acc32 = _mm256_add_epi32(acc32, sq);
     }
     acc64 = widen_add(acc64, acc32);
-    if (rows > 1 && j + 1 < rows) {
+    if (j + 1 < rows) {
       const int64_t s = hsum64(acc64);
       if (s > bound) return s;
     }
