@@ -73,6 +73,7 @@ int run_render(const Args& args) {
       "emaki render"};
   std::string scene_path, frames = "0", out_dir, clip;
   float fps = 24.0f, start_time = 0.0f;
+  bool loop = false;
   bool previews = false, full_float = false, quiet = false;
   ShotOptions so;
   app.add_option("scene", scene_path, "the scene, .gltf or .glb")->required();
@@ -82,6 +83,7 @@ int run_render(const Args& args) {
       ->capture_default_str();
   app.add_option("--out", out_dir, "output folder (created if missing)")->required();
   app.add_option("--clip", clip, "animation clip by name; default: the first clip");
+  app.add_flag("--loop", loop, "play the clip in a loop, so frames may run past its end");
   app.add_option("--start", start_time,
                  "seconds into the clip of frame 0, >= 0 (and within the clip)")
       ->check(CLI::NonNegativeNumber)
@@ -103,6 +105,7 @@ int run_render(const Args& args) {
   shot.fps = fps;
   shot.start_time = start_time;
   shot.clip = clip;
+  shot.loop = loop;
 
   const scene::Scene scene = io::load_gltf(scene_path);
   const render::ShotRenderer renderer(scene, shot, options);

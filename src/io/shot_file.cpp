@@ -335,6 +335,7 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     s.height = int(size[1]);
     s.shot.clip = r.string("clip", "");
     s.shot.start_time = r.real("start", 0.0f, 0.0);
+    s.shot.loop = r.boolean("loop", false);
     s.shot.fps = s.fps;
     s.shot.first_frame = s.first_frame;
     s.shot.last_frame = s.last_frame;
@@ -374,7 +375,7 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     const std::string raw = r.string("sequence", "");
     check_pattern(r.key_path("sequence"), raw);
     s.pattern = ctx.resolve(raw);
-    for (const char* k : {"clip", "start", "aa", "outline_width", "crease", "camera", "light",
+    for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera", "light",
                           "ground", "background", "size"})
       if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");
     if (const toml::table* t = r.table("channels")) {
@@ -692,7 +693,7 @@ Shot parse_shot(std::string_view text, const std::string& path) {
 
   {
     Reader src(*top.table("source", true), "source",
-               {"scene", "sequence", "frames", "size", "fps", "clip", "start", "aa",
+               {"scene", "sequence", "frames", "size", "fps", "clip", "start", "loop", "aa",
                 "outline_width", "crease", "camera", "light", "ground", "background", "channels"});
     parse_source(src, ctx, shot.source);
   }

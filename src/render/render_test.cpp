@@ -190,6 +190,39 @@ TEST(Render, FrameRangePastTheClipIsAnError) {
   EXPECT_THROW({ const ShotRenderer r(s, shot, RenderOptions{}); }, emaki::Error);
 }
 
+// A looping clip: frames run past the clip's end, and a frame one cycle later is the same pose.
+TEST(Render, LoopingClipRepeatsEveryCycle) {
+  const scene::Scene s = io::load_gltf(kScenes + "Fox.glb");
+  scene::ShotSpec shot;
+  shot.clip = "Walk";
+  shot.last_frame = 47;
+  EXPECT_THROW({ const ShotRenderer r(s, shot, RenderOptions{}); }, emaki::Error);
+  shot.loop = true;
+  RenderOptions options;
+  options.width = 160;
+  options.height = 90;
+  const ShotRenderer r(s, shot, options);
+  const scene::Animation& walk = s.animations[r.animation()];
+  const float duration = walk.end - walk.start;
+  const int cycle = int(std::lround(duration * shot.fps));
+  ASSERT_NEAR(cycle / shot.fps, duration, 1e-3f) << "the Walk clip is a whole number of frames";
+  for (int f : {0, 5, 16}) {
+    EXPECT_NEAR(r.time_of(float(f + cycle)), r.time_of(float(f)), 1e-4f) << f;
+    EXPECT_NEAR(r.time_of(float(f + 2 * cycle)), r.time_of(float(f)), 1e-4f) << f;
+  }
+  EXPECT_GE(r.time_of(-1.0f), walk.start);  // the motion pass of frame 0 looks back into the loop
+  EXPECT_LE(r.time_of(float(shot.last_frame)), walk.end);
+  // The camera does not move (no orbit/dolly), so a cycle later the passes are the same.
+  const Image<float> a = r.render(5), b = r.render(5 + cycle);
+  float worst = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c : {int(kNormal), kNormal + 1, kNormal + 2, int(kRestPosition), kRestPosition + 1})
+        worst = std::max(worst, std::abs(a(x, y, c) - b(x, y, c)));
+  EXPECT_LT(worst, 1e-3f);
+  EXPECT_GT(object_coverage(b.cview()), 0.01f);
+}
+
 // A ground-like quad far larger than the view, crossing the near plane, split into two
 // triangles: both are clipped, and the clipped pieces must still tile the view without cracks.
 TEST(Raster, ClippedQuadLeavesNoCracks) {

@@ -478,10 +478,11 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
       throw Error("--start", fmt::format("{} s is outside clip '{}' ({:.3f} s long)",
                                          shot_.start_time, a.name, duration));
     const int last_frame = int(std::floor((duration - shot_.start_time) * shot_.fps + 1e-3f));
-    if (shot_.last_frame > last_frame)
+    if (!shot_.loop && shot_.last_frame > last_frame)
       throw Error("--frames",
                   fmt::format("frame {} is at {:.3f} s, past the end of clip '{}' "
-                              "({:.3f} s long: frames 0-{} at {} fps from {} s)",
+                              "({:.3f} s long: frames 0-{} at {} fps from {} s; --loop plays it "
+                              "in a loop)",
                               shot_.last_frame, shot_.start_time + shot_.last_frame / shot_.fps,
                               a.name, duration, last_frame, shot_.fps, shot_.start_time));
   }
@@ -515,18 +516,21 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
   light_ = scene::light_direction(shot_, camera(float(shot_.first_frame)));
 }
 
-float ShotRenderer::time_of(int frame) const {
-  const float start = animation_ >= 0 ? scene_.animations[animation_].start : 0.0f;
-  return start + shot_.start_time + float(frame) / shot_.fps;
+float ShotRenderer::time_of(float frame) const {
+  if (animation_ < 0) return shot_.start_time + frame / shot_.fps;
+  const scene::Animation& a = scene_.animations[animation_];
+  double t = double(shot_.start_time) + double(frame) / shot_.fps;
+  const double duration = double(a.end) - a.start;
+  // Wrapped in double, so frame f and f + one cycle land on the same clip time.
+  if (shot_.loop && duration > 0.0) t -= std::floor(t / duration) * duration;
+  return a.start + float(t);
 }
 
 scene::ViewCamera ShotRenderer::camera(float frame) const {
   const float aspect = float(options_.width) / float(options_.height);
   scene::Pose pose;
-  if (shot_.camera.mode == scene::CameraSpec::Mode::kGltf) {
-    const float start = animation_ >= 0 ? scene_.animations[animation_].start : 0.0f;
-    pose = scene::evaluate_pose(scene_, animation_, start + shot_.start_time + frame / shot_.fps);
-  }
+  if (shot_.camera.mode == scene::CameraSpec::Mode::kGltf)
+    pose = scene::evaluate_pose(scene_, animation_, time_of(frame));
   return scene::camera_at(shot_, scene_, pose, shot_bounds_, frame, aspect, &fit_points_);
 }
 

@@ -38,8 +38,8 @@ class ShotRenderer {
   // The kChannelCount-channel frame (see passes.h).
   Image<float> render(int frame) const;
 
-  // The clip time of a frame: clip start + start_time + frame / fps.
-  float time_of(int frame) const;
+  // The clip time of a frame: clip start + start_time + frame / fps (wrapped when looping).
+  float time_of(float frame) const;
   int animation() const { return animation_; }
   const scene::Bounds& position_box() const { return position_box_; }
   const scene::Bounds& rest_box() const { return rest_box_; }

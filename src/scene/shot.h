@@ -63,6 +63,9 @@ struct ShotSpec {
   float start_time = 0.0f;  // seconds into the clip of frame 0, [0, clip length]
   int first_frame = 0;      // frame f is at time clip.start + start_time + f / fps
   int last_frame = 0;
+  // Play the clip in a loop: clip time wraps around its length, so a walk cycle covers any frame
+  // range. Off: a frame past the clip's end is an error.
+  bool loop = false;
 };
 
 // A resolved camera: world -> camera (looking down -Z, +Y up) and projection parameters.
