@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "io/image_io.h"
 #include "io/shot_inputs.h"
+#include "io/studio_passes.h"
 #include "render/passes.h"
 
 namespace emaki::io {
@@ -368,15 +369,19 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       const composite::Color c = g.color("color", {0.8f, 0.8f, 0.8f});
       s.shot.ground.color = {c.r, c.g, c.b};
     }
-    if (r.has("channels"))
-      throw Error(r.key_path("channels"), "applies to a 'sequence' source only");
+    for (const char* k : {"channels", "preset", "view_layer"})
+      if (r.has(k)) throw Error(r.key_path(k), "applies to a 'sequence' source only");
   } else {
     s.kind = pipeline::SourceKind::kSequence;
     const std::string raw = r.string("sequence", "");
     check_pattern(r.key_path("sequence"), raw);
     s.pattern = ctx.resolve(raw);
-    for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera", "light",
-                          "ground", "background", "size"})
+    s.preset = r.choice("preset", "emaki", {"emaki", "blender"});
+    if (r.has("view_layer") && s.preset != "blender")
+      throw Error(r.key_path("view_layer"), "applies to preset = \"blender\" only");
+    s.view_layer = r.string("view_layer", s.view_layer);
+    for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera",
+                          "light", "ground", "background", "size"})
       if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");
     if (const toml::table* t = r.table("channels")) {
       const std::vector<std::string> passes = pass_names();
@@ -407,18 +412,46 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       throw Error(r.key_path("sequence"),
                   fmt::format("no such file '{}' (frame {})", first, s.first_frame));
     const std::vector<std::string> have = list_channels(first);
-    for (const render::PassInfo& p : render::pass_table()) {
-      const std::vector<std::string> want = source_channels(s, p);
-      std::string key = r.key_path("sequence");
-      for (const auto& cm : s.channels)
-        if (cm.pass == p.name) key = r.key_path("channels") + "." + p.name;
-      for (const std::string& ch : want)
-        if (std::find(have.begin(), have.end(), ch) == have.end())
-          throw Error(key,
-                      fmt::format("channel '{}' of pass '{}' is not in '{}'", ch, p.name, first));
+    auto has = [&](const std::string& ch) {
+      return std::find(have.begin(), have.end(), ch) != have.end();
+    };
+    auto missing = [&](const std::string& key, const std::string& ch, const std::string& what) {
+      std::string list;
+      for (std::size_t i = 0; i < have.size() && i < 64; ++i) list += (i ? ", " : "") + have[i];
+      if (have.size() > 64) list += fmt::format(", ... ({} more)", have.size() - 64);
+      throw Error(key, fmt::format("channel '{}' ({}) is not in '{}', which has: {}", ch, what,
+                                   first, list.empty() ? "no channels" : list));
+    };
+    for (const auto& cm : s.channels)
+      for (const std::string& ch : cm.channels)
+        if (!has(ch)) missing(r.key_path("channels") + "." + cm.pass, ch, "pass '" + cm.pass + "'");
+    std::string alpha_channel;
+    if (s.preset == "blender") {
+      for (const std::string& ch : blender_channels(s.view_layer))
+        if (!has(ch))
+          missing(r.key_path("preset"), ch,
+                  fmt::format("a pass preset 'blender' reads from view layer '{}'", s.view_layer));
+      alpha_channel = s.view_layer + ".Combined.A";
+    } else {
+      for (const render::PassInfo& p : render::pass_table()) {
+        bool mapped = false;
+        for (const auto& cm : s.channels) mapped = mapped || cm.pass == p.name;
+        if (mapped) continue;
+        const std::vector<std::string> want = source_channels(s, p);
+        const auto absent =
+            std::find_if(want.begin(), want.end(), [&](const std::string& ch) { return !has(ch); });
+        if (absent == want.end()) continue;
+        // A single-channel pass as Blender's File Output node names a value socket.
+        const std::string value = std::string(p.name) + ".V";
+        if (p.count == 1 && has(value)) {
+          s.channels.push_back({p.name, {value}});
+          continue;
+        }
+        missing(r.key_path("sequence"), *absent, fmt::format("pass '{}'", p.name));
+      }
+      alpha_channel = source_channels(s, *render::find_pass("alpha"))[0];
     }
-    const AnyImage probe =
-        read_image(first, ReadOptions{source_channels(s, *render::find_pass("alpha"))});
+    const AnyImage probe = read_image(first, ReadOptions{{alpha_channel}});
     s.width = probe.width();
     s.height = probe.height();
   }
@@ -694,7 +727,8 @@ Shot parse_shot(std::string_view text, const std::string& path) {
   {
     Reader src(*top.table("source", true), "source",
                {"scene", "sequence", "frames", "size", "fps", "clip", "start", "loop", "aa",
-                "outline_width", "crease", "camera", "light", "ground", "background", "channels"});
+                "outline_width", "crease", "camera", "light", "ground", "background", "channels",
+                "preset", "view_layer"});
     parse_source(src, ctx, shot.source);
   }
 

@@ -6,12 +6,14 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "core/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
+#include "io/studio_passes.h"
 
 extern char** environ;
 
@@ -47,6 +49,25 @@ std::vector<std::string> source_channels(const pipeline::Source& source,
   return names;
 }
 
+Image<float> read_pass_file(const std::string& file, const std::string& preset,
+                            const std::string& view_layer) {
+  if (preset == "blender") {
+    const Image<float> raw = read_image_float(file, ReadOptions{blender_channels(view_layer)});
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    add_blender_bounds(raw.cview(), lo, hi);
+    return blender_to_emaki(raw.cview(), cube_around(lo, hi), file);
+  }
+  const std::vector<std::string> have = list_channels(file);
+  std::vector<std::string> names;
+  for (const render::PassInfo& p : render::pass_table())
+    for (int c = 0; c < p.count; ++c) {
+      const std::string name = fmt::format("{}.{}", p.name, p.suffixes[c]);
+      const bool found = std::find(have.begin(), have.end(), name) != have.end();
+      names.push_back(found || p.count > 1 ? name : std::string(p.name) + ".V");
+    }
+  return read_image_float(file, ReadOptions{names});
+}
+
 namespace {
 
 // Errors from the renderer name its command-line options; here they are shot file keys.
@@ -60,21 +81,54 @@ namespace {
 class SequenceFrames : public pipeline::FrameSource {
  public:
   explicit SequenceFrames(const pipeline::Source& s) : source_(s) {
+    if (s.preset == "blender") {
+      raw_ = blender_channels(s.view_layer);
+      for (const auto& m : s.channels)
+        for (const std::string& c : m.channels) channels_.push_back(c);
+      // position_norm's cube: every frame's covered positions, so it is fixed for the shot.
+      glm::vec3 lo(INFINITY), hi(-INFINITY);
+      for (int f = s.first_frame; f <= s.last_frame; ++f) {
+        const Image<float> raw = read_raw(frame_file(s.pattern, f));
+        add_blender_bounds(raw.cview(), lo, hi);
+      }
+      cube_ = cube_around(lo, hi);
+      return;
+    }
     for (const render::PassInfo& p : render::pass_table())
       for (const std::string& c : source_channels(s, p)) channels_.push_back(c);
   }
   Image<float> passes(int frame) const override {
     const std::string file = frame_file(source_.pattern, frame);
-    Image<float> img = read_image_float(file, ReadOptions{channels_});
+    if (source_.preset != "blender") return read_checked(file, channels_);
+    Image<float> out = blender_to_emaki(read_raw(file).cview(), cube_, file);
+    // Passes mapped in source.channels are read as they are, over the converted ones.
+    if (!channels_.empty()) {
+      const Image<float> mapped = read_checked(file, channels_);
+      int k = 0;
+      for (const auto& m : source_.channels) {
+        const render::PassInfo* p = render::find_pass(m.pass);
+        for (int c = 0; c < p->count; ++c, ++k)
+          for (int y = 0; y < out.height(); ++y)
+            for (int x = 0; x < out.width(); ++x) out(x, y, p->first + c) = mapped(x, y, k);
+      }
+    }
+    return out;
+  }
+
+ private:
+  Image<float> read_checked(const std::string& file, const std::vector<std::string>& ch) const {
+    Image<float> img = read_image_float(file, ReadOptions{ch});
     if (img.width() != source_.width || img.height() != source_.height)
       throw Error(file, fmt::format("is {}x{}, the sequence's first frame is {}x{}", img.width(),
                                     img.height(), source_.width, source_.height));
     return img;
   }
+  Image<float> read_raw(const std::string& file) const { return read_checked(file, raw_); }
 
- private:
   pipeline::Source source_;
-  std::vector<std::string> channels_;
+  std::vector<std::string> channels_;  // emaki: every pass; blender: the mapped passes only
+  std::vector<std::string> raw_;       // blender: blender_channels()
+  Cube cube_;
 };
 
 Image<float> rgb_of(const std::string& key, const std::string& path) {
@@ -137,6 +191,11 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
           std::vector<std::string> names;
           for (int c = 0; c < p->count; ++c)
             names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
+          // tools/blender/emaki_passes.py writes a single-channel pass as NAME.V.
+          const std::string value = std::string(p->name) + ".V";
+          if (p->count == 1 && std::find(have.begin(), have.end(), names[0]) == have.end() &&
+              std::find(have.begin(), have.end(), value) != have.end())
+            names = {value};
           for (const std::string& n : names)
             if (std::find(have.begin(), have.end(), n) == have.end())
               throw Error(key + ".passes",

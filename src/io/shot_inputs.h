@@ -23,6 +23,13 @@ std::string frame_file(const std::string& pattern, int frame);
 std::vector<std::string> source_channels(const pipeline::Source& source,
                                          const render::PassInfo& pass);
 
+// One pass file as emaki's frame (render::kChannelCount channels): `preset` "emaki" reads
+// emaki's channel names (a single-channel pass also as NAME.V, as the Blender exporter writes
+// it); "blender" converts a plain Blender render of view layer `view_layer`, position_norm's
+// cube taken from this frame alone.
+Image<float> read_pass_file(const std::string& file, const std::string& preset = "emaki",
+                            const std::string& view_layer = "ViewLayer");
+
 // The shot's frames. Errors name the shot file's keys (source.scene, source.clip, ...).
 std::unique_ptr<pipeline::FrameSource> open_frames(const pipeline::Shot& shot);
 

@@ -37,6 +37,11 @@ struct Source {
   // kSequence
   std::string pattern;  // printf-style with one integer, e.g. renders/frame_%04d.exr
   std::vector<ChannelMapping> channels;  // passes read under other names than emaki's
+  // How the file's channels are named and what they mean: "emaki" (emaki's names and
+  // conventions, as `emaki render` and tools/blender/emaki_passes.py write them) or "blender"
+  // (a plain Cycles render, converted: io/studio_passes.h). `channels` overrides either.
+  std::string preset = "emaki";
+  std::string view_layer = "ViewLayer";  // "blender": the view layer's channel prefix
 };
 
 enum class ExemplarKind {
