@@ -98,5 +98,27 @@ TEST(ShotFile, ErrorsNameTheKeyPath) {
             0u);
 }
 
+TEST(ShotFile, ChannelPresetKeysAreChecked) {
+  const std::string layer = "[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n";
+  std::string scene = minimal(layer);  // a scene source has no channel preset
+  scene.insert(scene.find("size"), "preset = \"blender\"\n");
+  EXPECT_EQ(error_of(scene).rfind("source.preset: applies to a 'sequence' source only", 0), 0u);
+  auto sequence = [&](const std::string& keys) {
+    std::string text = minimal(layer);
+    const std::size_t from = text.find("scene = "), to = text.find("size = [64, 48]\n");
+    return text.replace(from, to + 16 - from,
+                        "sequence = \"/nonexistent/frame_%04d.exr\"\nframes = [0, 3]\n" + keys);
+  };
+  EXPECT_EQ(error_of(sequence("preset = \"maya\"\n")).rfind("source.preset:", 0), 0u);
+  EXPECT_NE(error_of(sequence("preset = \"maya\"\n")).find("blender"), std::string::npos);
+  EXPECT_EQ(error_of(sequence("view_layer = \"RenderLayer\"\n"))
+                .rfind("source.view_layer: applies to preset = \"blender\" only", 0),
+            0u);
+  // With the keys right, the next error is the missing first frame.
+  EXPECT_EQ(error_of(sequence("preset = \"blender\"\nview_layer = \"RenderLayer\"\n"))
+                .rfind("source.sequence: no such file", 0),
+            0u);
+}
+
 }  // namespace
 }  // namespace emaki::io

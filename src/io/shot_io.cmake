@@ -6,3 +6,4 @@ emaki_module(shot_io
   DEPS emaki_pipeline emaki_io emaki_core
   PRIVATE_DEPS tomlplusplus::tomlplusplus fmt::fmt)
 emaki_test(shot_file_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shot_file_test.cpp DEPS emaki_shot_io)
+emaki_test(studio_passes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/studio_passes_test.cpp DEPS emaki_shot_io)

@@ -1,11 +1,13 @@
 // The figures of the Blender tests (tests/blender/*.sh):
 //
 //   blender_check compare A.exr[:PRESET] B.exr[:PRESET] [--max-normal-deg D] [--max-position F]
-//                 [--min-iou F]
+//                 [--min-iou F] [--max-motion PX]
 //     Two pass files of the same frame (PRESET "emaki", the default, or "blender"): coverage IoU
 //     (alpha > 0.5), mean normal angle and mean position error over the pixels both cover fully
 //     (position as a fraction of the side of A's normalisation cube, and the mean difference of
 //     position_norm), depth and albedo differences. Exits 1 when a limit is exceeded.
+//
+//   blender_check passes FILE[:PRESET]...   (ranges of each pass; see passes() below)
 //
 //   blender_check outputs OUT_DIR FIRST LAST LAYER...
 //     A finished `emaki run`: each frame's layered EXR holds every pass, each layer and the
@@ -39,7 +41,7 @@ Image<float> load(const std::string& arg) {
 
 int compare(int argc, char** argv) {
   if (argc < 4) throw emaki::Error("compare", "needs two pass files");
-  double max_normal = INFINITY, max_position = INFINITY, min_iou = 0.0;
+  double max_normal = INFINITY, max_position = INFINITY, min_iou = 0.0, max_motion = INFINITY;
   for (int i = 4; i + 1 < argc; i += 2) {
     const std::string opt = argv[i];
     const double v = std::atof(argv[i + 1]);
@@ -49,6 +51,8 @@ int compare(int argc, char** argv) {
       max_position = v;
     else if (opt == "--min-iou")
       min_iou = v;
+    else if (opt == "--max-motion")
+      max_motion = v;
     else
       throw emaki::Error(opt, "unknown option");
   }
@@ -61,6 +65,7 @@ int compare(int argc, char** argv) {
   double side = 0.0;
   long both = 0, either = 0, full = 0;
   double normal_deg = 0.0, position = 0.0, position_norm = 0.0, depth = 0.0, albedo = 0.0;
+  double motion = 0.0, rest = 0.0;
   for (int y = 0; y < a.height(); ++y)
     for (int x = 0; x < a.width(); ++x) {
       const float* pa = a.at(x, y);
@@ -72,7 +77,7 @@ int compare(int argc, char** argv) {
       // A's cube side from any fully covered pixel: position = lo + side * position_norm.
       if (!p0 && std::abs(pa[render::kPositionNorm] - 0.5f) > 0.1f) p0 = pa;
       ++full;
-      double dot = 0.0, la = 0.0, lb = 0.0, dp = 0.0, dn = 0.0, dc = 0.0;
+      double dot = 0.0, la = 0.0, lb = 0.0, dp = 0.0, dn = 0.0, dc = 0.0, dr = 0.0;
       for (int c = 0; c < 3; ++c) {
         dot += double(pa[render::kNormal + c]) * pb[render::kNormal + c];
         la += double(pa[render::kNormal + c]) * pa[render::kNormal + c];
@@ -80,7 +85,11 @@ int compare(int argc, char** argv) {
         dp += std::pow(double(pa[render::kPosition + c]) - pb[render::kPosition + c], 2);
         dn += std::pow(double(pa[render::kPositionNorm + c]) - pb[render::kPositionNorm + c], 2);
         dc += std::abs(double(pa[render::kAlbedo + c]) - pb[render::kAlbedo + c]) / 3.0;
+        dr += std::pow(double(pa[render::kRestPosition + c]) - pb[render::kRestPosition + c], 2);
       }
+      motion += std::hypot(double(pa[render::kMotion]) - pb[render::kMotion],
+                           double(pa[render::kMotion + 1]) - pb[render::kMotion + 1]);
+      rest += std::sqrt(dr);
       normal_deg += std::acos(std::clamp(dot / std::sqrt(la * lb + 1e-30), -1.0, 1.0)) * 180.0 /
                     3.14159265358979;
       position += std::sqrt(dp);
@@ -109,15 +118,17 @@ int compare(int argc, char** argv) {
       "pixels covered: both %ld, either %ld; coverage IoU %.4f; over %ld fully covered pixels: "
       "normal mean angle %.3f deg, position mean error %.5f of the box (box side %.4g), "
       "position_norm mean difference %.5f, depth mean relative error %.5f, albedo mean "
-      "difference %.4f\n",
+      "difference %.4f, motion mean difference %.3f px, rest_position mean difference %.4f\n",
       both, either, iou, full, normal_deg, pos_frac, side, position_norm / full, depth / full,
-      albedo / full);
+      albedo / full, motion / full, rest / full);
   bool ok = true;
   if (normal_deg > max_normal)
     std::printf("FAIL: normal angle %.3f > %.3f deg\n", normal_deg, max_normal), ok = false;
   if (pos_frac > max_position)
     std::printf("FAIL: position error %.5f > %.5f of the box\n", pos_frac, max_position),
         ok = false;
+  if (motion / full > max_motion)
+    std::printf("FAIL: motion %.3f > %.3f px\n", motion / full, max_motion), ok = false;
   if (iou < min_iou) std::printf("FAIL: coverage IoU %.4f < %.4f\n", iou, min_iou), ok = false;
   return ok ? 0 : 1;
 }
@@ -172,6 +183,56 @@ int outputs(int argc, char** argv) {
   return ok ? 0 : 1;
 }
 
+// blender_check passes FILE[:PRESET]...: each file's passes hold emaki's ranges: alpha, diffuse,
+// shadow and outline in [0, 1], unit normals facing the camera, positive depth, integer ids,
+// objects' position_norm and rest_position in [0, 1], where covered. Exits 1 otherwise.
+int passes(int argc, char** argv) {
+  bool ok = true;
+  for (int i = 2; i < argc; ++i) {
+    const Image<float> img = load(argv[i]);
+    long covered = 0, bad = 0;
+    std::string first_bad;
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x) {
+        const float* p = img.at(x, y);
+        auto check = [&](bool good, const char* what) {
+          if (good) return;
+          if (bad++ == 0) first_bad = fmt::format("{} at ({}, {})", what, x, y);
+        };
+        for (int c : {render::kAlpha, render::kDiffuse, render::kShadow, render::kOutline})
+          check(p[c] >= 0.0f && p[c] <= 1.0f, "a value outside [0, 1]");
+        for (int c : {render::kObjectId, render::kMaterialId})
+          check(p[c] == std::round(p[c]) && p[c] >= 0.0f, "an id that is no integer");
+        if (p[render::kAlpha] < 0.999f) continue;
+        ++covered;
+        // Inside one object only: an edge pixel averages two surfaces under one id.
+        bool inside = x > 0 && y > 0 && x + 1 < img.width() && y + 1 < img.height();
+        for (int d = 0; inside && d < 4; ++d) {
+          const float* q = img.at(x + (d == 0) - (d == 1), y + (d == 2) - (d == 3));
+          inside = q[render::kObjectId] == p[render::kObjectId] && q[render::kAlpha] >= 0.999f;
+        }
+        if (!inside) continue;
+        const float len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        check(std::abs(len - 1.0f) < 0.05f, "a normal that is not unit length");
+        check(p[render::kNormal + 2] > -0.3f, "a normal facing away from the camera");
+        check(p[render::kDepth] > 0.0f, "depth <= 0 on a covered pixel");
+        if (p[render::kObjectId] >= 2.0f)
+          for (int c = 0; c < 3; ++c) {
+            check(p[render::kPositionNorm + c] > -0.01f && p[render::kPositionNorm + c] < 1.01f,
+                  "an object's position_norm outside [0, 1]");
+            check(p[render::kRestPosition + c] > -0.01f && p[render::kRestPosition + c] < 1.01f,
+                  "an object's rest_position outside [0, 1]");
+          }
+      }
+    std::printf("%s: %ld fully covered pixels, %ld values out of range%s%s\n", argv[i], covered,
+                bad, bad ? ", first: " : "", first_bad.c_str());
+    // A few back-facing or averaged edge normals are allowed; nothing else.
+    if (covered == 0 || bad > covered / 200) ok = false;
+  }
+  if (!ok) std::printf("FAIL\n");
+  return ok ? 0 : 1;
+}
+
 // blender_check pixel X Y FILE[:PRESET]...: every pass value of one pixel (for debugging).
 int pixel(int argc, char** argv) {
   const int x = std::atoi(argv[2]), y = std::atoi(argv[3]);
@@ -191,6 +252,7 @@ int main(int argc, char** argv) {
     if (argc >= 2 && std::string(argv[1]) == "compare") return compare(argc, argv);
     if (argc >= 2 && std::string(argv[1]) == "outputs") return outputs(argc, argv);
     if (argc >= 5 && std::string(argv[1]) == "pixel") return pixel(argc, argv);
+    if (argc >= 3 && std::string(argv[1]) == "passes") return passes(argc, argv);
     std::fprintf(stderr,
                  "usage: blender_check compare A.exr[:preset] B.exr[:preset] ... | "
                  "outputs OUT_DIR FIRST LAST LAYER...\n");

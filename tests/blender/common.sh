@@ -23,5 +23,5 @@ run() {
 }
 # Blender on at most 2 threads, without the user's startup file or add-ons.
 blender_run() {
-  run blender -b --factory-startup -t 2 "$@"
+  run blender -b --factory-startup -t 2 --python-exit-code 1 "$@"
 }

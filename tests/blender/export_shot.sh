@@ -8,7 +8,7 @@ set -e
 . "$(dirname "$0")/common.sh"
 
 blender_run -P "$HERE/make_scene.py" -- "$WORK/scene.blend"
-run blender -b "$WORK/scene.blend" -t 2 -P "$EXPORTER" -- --out "$WORK/renders" --frames 1-4 \
+blender_run "$WORK/scene.blend" -P "$EXPORTER" -- --out "$WORK/renders" --frames 1-4 \
   --samples 8
 # The StyLit painting at a quarter of its size, and Blender's reference sphere fitted to it
 # (examples/stylit_fit.txt at 1/4 scale).
@@ -20,6 +20,16 @@ for f in renders/frame_0001.exr renders/frame_0004.exr reference/reference.exr \
   reference/template.png; do
   [ -f "$WORK/$f" ] || { echo "FAIL: the exporter did not write $f"; exit 1; }
 done
+"$CHECK" passes "$WORK"/renders/frame_000[1-4].exr "$WORK/reference/reference.exr"
+# The add-on: registered, its operator renders the scene's (here: first) frame.
+blender_run "$WORK/scene.blend" --python-expr "import sys, bpy
+sys.path.insert(0, '$ROOT/tools/blender')
+import emaki_passes
+emaki_passes.register()
+bpy.context.scene.frame_end = 1
+bpy.context.scene.emaki_out = '$WORK/addon'
+assert bpy.ops.emaki.render_passes() == {'FINISHED'}"
+"$CHECK" passes "$WORK/addon/frame_0001.exr"
 # Blender's reference against emaki's own reference scene with the same settings.
 run "$EMAKI" template --size 300x228 --sphere 152.05,123.55,60.6 --elevation 20 --fov 30 \
   --light 0.3,0.9,-0.3 --softness 8 --out "$WORK/emaki_reference"

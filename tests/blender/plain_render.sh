@@ -7,9 +7,11 @@ set -e
 . "$(dirname "$0")/common.sh"
 
 blender_run -P "$HERE/make_scene.py" -- "$WORK/scene.blend"
-run blender -b "$WORK/scene.blend" -t 2 -P "$HERE/plain_render.py" -- --out "$WORK/renders" \
+blender_run "$WORK/scene.blend" -P "$HERE/plain_render.py" -- --out "$WORK/renders" \
   --frames 1-4 --samples 8
 run oiiotool "$ROOT/examples/stylit/source_style.png" --resize 300x228 -o "$WORK/painting.png"
+
+"$CHECK" passes "$WORK"/renders/frame_0001.exr:blender "$WORK"/renders/frame_0004.exr:blender
 
 shot() {  # $1: extra source keys, $2: output folder
   cat <<TOML

@@ -336,8 +336,16 @@ def build_compositor(scene, out_pattern_base, template_png=None):
         r, g, b = colour_channels(sock)
         return combine(unpremul_value(r), unpremul_value(g), unpremul_value(b))
 
+    def unit_vec(sock):
+        # An edge pixel averages differing normals; emaki's normal is unit length.
+        r, g, b = colour_channels(sock)
+        sq = mop("ADD", mop("ADD", mop("MULTIPLY", r, r), mop("MULTIPLY", g, g)),
+                 mop("MULTIPLY", b, b))
+        inv = mop("DIVIDE", 1.0, mop("MAXIMUM", mop("SQRT", sq), 1e-6))
+        return combine(mop("MULTIPLY", r, inv), mop("MULTIPLY", g, inv), mop("MULTIPLY", b, inv))
+
     outs = {}
-    outs["normal"] = rgb_as_vec(rl.outputs["emaki_normal"])
+    outs["normal"] = unit_vec(rl.outputs["emaki_normal"])
     outs["position"] = rgb_as_vec(rl.outputs["emaki_position"])
     outs["position_norm"] = rgb_as_vec(rl.outputs["emaki_position_norm"])
     outs["rest_position"] = rgb_as_vec(rl.outputs["emaki_rest_position"])
