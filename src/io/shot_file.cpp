@@ -369,7 +369,7 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       const composite::Color c = g.color("color", {0.8f, 0.8f, 0.8f});
       s.shot.ground.color = {c.r, c.g, c.b};
     }
-    for (const char* k : {"channels", "preset", "view_layer"})
+    for (const char* k : {"channels", "preset", "view_layer", "normals", "up", "premultiplied"})
       if (r.has(k)) throw Error(r.key_path(k), "applies to a 'sequence' source only");
   } else {
     s.kind = pipeline::SourceKind::kSequence;
@@ -380,6 +380,14 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     if (r.has("view_layer") && s.preset != "blender")
       throw Error(r.key_path("view_layer"), "applies to preset = \"blender\" only");
     s.view_layer = r.string("view_layer", s.view_layer);
+    for (const char* k : {"normals", "up", "premultiplied"})
+      if (r.has(k) && s.preset == "blender")
+        throw Error(r.key_path(k),
+                    "applies to preset = \"emaki\" only (\"blender\" knows "
+                    "Blender's conventions)");
+    s.world_normals = r.choice("normals", "camera", {"camera", "world"}) == "world";
+    s.z_up = r.choice("up", "y", {"y", "z"}) == "z";
+    s.premultiplied = r.boolean("premultiplied", false);
     for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera",
                           "light", "ground", "background", "size"})
       if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");
@@ -726,9 +734,10 @@ Shot parse_shot(std::string_view text, const std::string& path) {
 
   {
     Reader src(*top.table("source", true), "source",
-               {"scene", "sequence", "frames", "size", "fps", "clip", "start", "loop", "aa",
-                "outline_width", "crease", "camera", "light", "ground", "background", "channels",
-                "preset", "view_layer"});
+               {"scene",   "sequence", "frames",       "size",          "fps",    "clip",
+                "start",   "loop",     "aa",           "outline_width", "crease", "camera",
+                "light",   "ground",   "background",   "channels",      "preset", "view_layer",
+                "normals", "up",       "premultiplied"});
     parse_source(src, ctx, shot.source);
   }
 

@@ -114,6 +114,10 @@ TEST(ShotFile, ChannelPresetKeysAreChecked) {
   EXPECT_EQ(error_of(sequence("view_layer = \"RenderLayer\"\n"))
                 .rfind("source.view_layer: applies to preset = \"blender\" only", 0),
             0u);
+  EXPECT_EQ(error_of(sequence("preset = \"blender\"\nnormals = \"world\"\n"))
+                .rfind("source.normals: applies to preset = \"emaki\" only", 0),
+            0u);
+  EXPECT_EQ(error_of(sequence("up = \"x\"\n")).rfind("source.up:", 0), 0u);
   // With the keys right, the next error is the missing first frame.
   EXPECT_EQ(error_of(sequence("preset = \"blender\"\nview_layer = \"RenderLayer\"\n"))
                 .rfind("source.sequence: no such file", 0),

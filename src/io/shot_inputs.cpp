@@ -99,7 +99,11 @@ class SequenceFrames : public pipeline::FrameSource {
   }
   Image<float> passes(int frame) const override {
     const std::string file = frame_file(source_.pattern, frame);
-    if (source_.preset != "blender") return read_checked(file, channels_);
+    if (source_.preset != "blender") {
+      Image<float> frame = read_checked(file, channels_);
+      apply_conventions(frame, {source_.world_normals, source_.z_up, source_.premultiplied}, file);
+      return frame;
+    }
     Image<float> out = blender_to_emaki(read_raw(file).cview(), cube_, file);
     // Passes mapped in source.channels are read as they are, over the converted ones.
     if (!channels_.empty()) {

@@ -318,4 +318,48 @@ Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
   return out;
 }
 
+void apply_conventions(Image<float>& frame, const AovConventions& conv, const std::string& file) {
+  using namespace render;
+  CHECK_EQ(frame.channels(), kChannelCount);
+  const int w = frame.width(), h = frame.height();
+  std::vector<glm::vec3> world_points;
+  std::vector<glm::vec2> pixels;
+  const int step = std::max(1, int(std::sqrt(double(w) * h / 4000.0)));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float* o = frame.at(x, y);
+      const float a = o[kAlpha];
+      if (a <= kCovered) continue;
+      if (conv.premultiplied)
+        for (int c = 0; c < kChannelCount; ++c)
+          if (c < kObjectId || c >= kMotion) {
+            if (c != kAlpha) o[c] /= a;
+          }
+      if (conv.z_up) {
+        const glm::vec3 p = yup(o[kPosition], o[kPosition + 1], o[kPosition + 2]);
+        for (int c = 0; c < 3; ++c) o[kPosition + c] = p[c];
+        if (conv.world_normals) {
+          const glm::vec3 n = yup(o[kNormal], o[kNormal + 1], o[kNormal + 2]);
+          for (int c = 0; c < 3; ++c) o[kNormal + c] = n[c];
+        }
+      }
+      if (a > 0.999f && x % step == 0 && y % step == 0) {
+        world_points.push_back({o[kPosition], o[kPosition + 1], o[kPosition + 2]});
+        pixels.push_back({x + 0.5f, y + 0.5f});
+      }
+    }
+  if (!conv.world_normals) return;
+  const CameraAxes cam = fit_camera_axes(world_points, pixels, file);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float* o = frame.at(x, y);
+      const glm::vec3 n(o[kNormal], o[kNormal + 1], o[kNormal + 2]);
+      if (o[kAlpha] <= kCovered || glm::length(n) < 1e-6f) continue;
+      const glm::vec3 u = glm::normalize(n);
+      o[kNormal] = glm::dot(u, cam.right);
+      o[kNormal + 1] = glm::dot(u, cam.up);
+      o[kNormal + 2] = glm::dot(u, cam.back);
+    }
+}
+
 }  // namespace emaki::io

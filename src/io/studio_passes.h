@@ -56,4 +56,14 @@ CameraAxes fit_camera_axes(const std::vector<glm::vec3>& world, const std::vecto
 Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& position_cube,
                               const std::string& file);
 
+// Another renderer's AOVs, read under emaki's names (source.channels), in its conventions.
+struct AovConventions {
+  bool world_normals = false;  // normal in world space: turned into the camera's (fitted) space
+  bool z_up = false;           // position and world normals Z-up: (x, y, z) -> (x, z, -y)
+  bool premultiplied = false;  // continuous passes divided by alpha
+};
+
+// Brings a frame read under emaki's channel order to emaki's conventions, in place.
+void apply_conventions(Image<float>& frame, const AovConventions& c, const std::string& file);
+
 }  // namespace emaki::io

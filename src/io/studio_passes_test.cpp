@@ -179,6 +179,37 @@ TEST(BlenderToEmaki, DividesTheLightStrengthOutOfDiffuse) {
     }
 }
 
+TEST(ApplyConventions, ConvertsWorldNormalsZUpAndPremultipliedValues) {
+  const TestCamera cam({2.0f, 3.0f, 5.0f}, {0.0f, 0.5f, 0.0f}, 60.0f, 24.0f, 16.0f);
+  Image<float> frame(48, 32, kChannelCount);
+  const glm::vec3 n_world = glm::normalize(glm::vec3(0.2f, 1.0f, 0.1f));
+  auto zup = [](glm::vec3 p) { return glm::vec3(p.x, -p.z, p.y); };
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 48; ++x) {
+      float* o = frame.at(x, y);
+      const float a = x == 5 ? 0.25f : 1.0f;
+      const glm::vec3 p = zup(cam.unproject(x + 0.5f, y + 0.5f, 4.0f + std::sin(0.3f * x + y)));
+      const glm::vec3 n = zup(n_world);
+      for (int c = 0; c < 3; ++c) o[kPosition + c] = a * p[c], o[kNormal + c] = a * n[c];
+      o[kDiffuse] = a * 0.5f;
+      o[kObjectId] = 2.0f;
+      o[kAlpha] = a;
+    }
+  apply_conventions(frame, {true, true, true}, "f.exr");
+  for (int x : {5, 20}) {
+    const float* o = frame.at(x, 9);
+    EXPECT_NEAR(o[kNormal], glm::dot(n_world, cam.right), 1e-3f);
+    EXPECT_NEAR(o[kNormal + 1], glm::dot(n_world, cam.up), 1e-3f);
+    EXPECT_NEAR(o[kNormal + 2], glm::dot(n_world, cam.back), 1e-3f);
+    const glm::vec3 p = cam.unproject(x + 0.5f, 9.5f, 4.0f + std::sin(0.3f * x + 9));
+    EXPECT_NEAR(o[kPosition + 1], p.y, 1e-4f);
+    EXPECT_NEAR(o[kPosition + 2], p.z, 1e-4f);
+    EXPECT_NEAR(o[kDiffuse], 0.5f, 1e-6f);
+    EXPECT_EQ(o[kObjectId], 2.0f);  // ids are not divided
+  }
+  EXPECT_EQ(frame(5, 9, kAlpha), 0.25f);
+}
+
 TEST(BlenderToEmaki, ChannelNamesFollowTheViewLayer) {
   const std::vector<std::string> c = blender_channels("RenderLayer");
   ASSERT_EQ(int(c.size()), kBlenderChannelCount);

@@ -42,6 +42,10 @@ struct Source {
   // (a plain Cycles render, converted: io/studio_passes.h). `channels` overrides either.
   std::string preset = "emaki";
   std::string view_layer = "ViewLayer";  // "blender": the view layer's channel prefix
+  // "emaki" preset, for other renderers' AOVs: conventions converted on reading.
+  bool world_normals = false;  // normal is world-space (turned into camera space)
+  bool z_up = false;           // position (and world normals) are Z-up
+  bool premultiplied = false;  // continuous passes are premultiplied by alpha
 };
 
 enum class ExemplarKind {
