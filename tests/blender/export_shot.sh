@@ -30,6 +30,13 @@ bpy.context.scene.frame_end = 1
 bpy.context.scene.emaki_out = '$WORK/addon'
 assert bpy.ops.emaki.render_passes() == {'FINISHED'}"
 "$CHECK" passes "$WORK/addon/frame_0001.exr"
+# Bad input: one line naming the option, a non-zero exit, nothing written.
+if blender -b --factory-startup -P "$EXPORTER" -- --out "$WORK/bad" --frames 4-1 \
+  >"$WORK/err" 2>&1; then
+  echo "FAIL: the exporter accepted --frames 4-1"; exit 1
+fi
+grep "emaki_passes: error: --frames" "$WORK/err" || { cat "$WORK/err"; exit 1; }
+[ ! -e "$WORK/bad" ] || { echo "FAIL: the refused export created its folder"; exit 1; }
 # Blender's reference against emaki's own reference scene with the same settings.
 run "$EMAKI" template --size 300x228 --sphere 152.05,123.55,60.6 --elevation 20 --fov 30 \
   --light 0.3,0.9,-0.3 --softness 8 --out "$WORK/emaki_reference"

@@ -644,7 +644,12 @@ def add_look_at_camera(scene, position, target, fov):
 
 def parse_args(argv):
     import argparse
-    p = argparse.ArgumentParser(
+
+    class Parser(argparse.ArgumentParser):
+        def error(self, message):  # one line, as every other error
+            raise ExportError(message)
+
+    p = Parser(
         prog="blender -b [scene.blend] -P emaki_passes.py --",
         description="Render emaki's guide passes as multilayer EXRs (DIR/frame_NNNN.exr), or "
                     "with --reference the reference sphere (DIR/reference.exr + template.png).")
@@ -696,10 +701,19 @@ def import_gltf(path):
     return bpy.context.scene
 
 
+def make_folder(path):
+    """Created once the arguments check out, so a refused run leaves nothing behind."""
+    try:
+        os.makedirs(path, exist_ok=True)
+    except OSError as e:
+        raise ExportError("--out: cannot create '%s': %s" % (path, e.strerror))
+    if not os.access(path, os.W_OK):
+        raise ExportError("--out: '%s' is not writable" % path)
+
+
 def main(argv):
     args = parse_args(argv)
     out = os.path.abspath(args.out)
-    os.makedirs(out, exist_ok=True)
     size = None
     if args.size:
         try:
@@ -716,6 +730,7 @@ def main(argv):
         sphere = parse_triple(args.sphere, "--sphere") if args.sphere else None
         scene = build_reference(size, sphere, args.elevation, args.fov or 30.0,
                                 not args.no_ground)
+        make_folder(out)
         info = setup(scene, os.path.join(out, "reference_"), [0], size, args.samples, light,
                      args.light_world, args.softness, "ground",
                      template_png=os.path.join(out, "template_"))
@@ -749,6 +764,7 @@ def main(argv):
     else:
         a, b = scene.frame_start, scene.frame_end
     frames = list(range(a, b + 1))
+    make_folder(out)
     info = setup(scene, os.path.join(out, "frame_"), frames, size, args.samples, light,
                  args.light_world, args.softness, args.ground)
     render_frames(scene, out, frames)
@@ -764,16 +780,24 @@ class EMAKI_OT_render_passes(bpy.types.Operator):
     bl_description = "Render the scene's frame range as emaki guide passes into the folder"
 
     def execute(self, context):
+        # The export rewires materials, lights, world and compositor: it runs in a background
+        # Blender on a copy of the file, so the open scene stays as it is.
+        import subprocess
+        import tempfile
         scene = context.scene
         out = bpy.path.abspath(scene.emaki_out)
-        os.makedirs(out, exist_ok=True)
-        frames = list(range(scene.frame_start, scene.frame_end + 1))
-        try:
-            setup(scene, os.path.join(out, "frame_"), frames, None, scene.emaki_samples, None,
-                  False, 2.0, None)
-            render_frames(scene, out, frames)
-        except ExportError as e:
-            self.report({"ERROR"}, str(e))
+        with tempfile.TemporaryDirectory() as tmp:
+            copy = os.path.join(tmp, "scene.blend")
+            bpy.ops.wm.save_as_mainfile(filepath=copy, copy=True)
+            cmd = [bpy.app.binary_path, "-b", copy, "--scene", scene.name, "-P",
+                   os.path.abspath(__file__), "--", "--out", out, "--frames",
+                   "%d-%d" % (scene.frame_start, scene.frame_end),
+                   "--samples", str(scene.emaki_samples)]
+            proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            lines = [l for l in proc.stderr.splitlines() if "emaki_passes: error" in l]
+            self.report({"ERROR"}, lines[-1] if lines else "the export failed (see the console)")
+            print(proc.stdout[-4000:], proc.stderr[-4000:])
             return {"CANCELLED"}
         self.report({"INFO"}, "emaki passes written to %s" % out)
         return {"FINISHED"}
