@@ -65,7 +65,8 @@ int compare(int argc, char** argv) {
   double side = 0.0;
   long both = 0, either = 0, full = 0;
   double normal_deg = 0.0, position = 0.0, position_norm = 0.0, depth = 0.0, albedo = 0.0;
-  double motion = 0.0, rest = 0.0;
+  double motion = 0.0, rest = 0.0, diffuse = 0.0, shadow = 0.0;
+  long line_both = 0, line_either = 0;
   for (int y = 0; y < a.height(); ++y)
     for (int x = 0; x < a.width(); ++x) {
       const float* pa = a.at(x, y);
@@ -73,6 +74,9 @@ int compare(int argc, char** argv) {
       const bool ca = pa[render::kAlpha] > 0.5f, cb = pb[render::kAlpha] > 0.5f;
       both += ca && cb;
       either += ca || cb;
+      const bool line_a = pa[render::kOutline] > 0.5f, line_b = pb[render::kOutline] > 0.5f;
+      line_both += line_a && line_b;
+      line_either += line_a || line_b;
       if (pa[render::kAlpha] < 0.999f || pb[render::kAlpha] < 0.999f) continue;
       // A's cube side from any fully covered pixel: position = lo + side * position_norm.
       if (!p0 && std::abs(pa[render::kPositionNorm] - 0.5f) > 0.1f) p0 = pa;
@@ -90,6 +94,8 @@ int compare(int argc, char** argv) {
       motion += std::hypot(double(pa[render::kMotion]) - pb[render::kMotion],
                            double(pa[render::kMotion + 1]) - pb[render::kMotion + 1]);
       rest += std::sqrt(dr);
+      diffuse += std::abs(double(pa[render::kDiffuse]) - pb[render::kDiffuse]);
+      shadow += std::abs(double(pa[render::kShadow]) - pb[render::kShadow]);
       normal_deg += std::acos(std::clamp(dot / std::sqrt(la * lb + 1e-30), -1.0, 1.0)) * 180.0 /
                     3.14159265358979;
       position += std::sqrt(dp);
@@ -118,9 +124,11 @@ int compare(int argc, char** argv) {
       "pixels covered: both %ld, either %ld; coverage IoU %.4f; over %ld fully covered pixels: "
       "normal mean angle %.3f deg, position mean error %.5f of the box (box side %.4g), "
       "position_norm mean difference %.5f, depth mean relative error %.5f, albedo mean "
-      "difference %.4f, motion mean difference %.3f px, rest_position mean difference %.4f\n",
+      "difference %.4f, motion mean difference %.3f px, rest_position mean difference %.4f, "
+      "diffuse mean difference %.4f, shadow mean difference %.4f; outline IoU %.3f\n",
       both, either, iou, full, normal_deg, pos_frac, side, position_norm / full, depth / full,
-      albedo / full, motion / full, rest / full);
+      albedo / full, motion / full, rest / full, diffuse / full, shadow / full,
+      line_either ? double(line_both) / line_either : 1.0);
   bool ok = true;
   if (normal_deg > max_normal)
     std::printf("FAIL: normal angle %.3f > %.3f deg\n", normal_deg, max_normal), ok = false;
