@@ -1,6 +1,6 @@
 # A small animated test scene, made from nothing: a ground plane, a cube, a smooth sphere and a
-# torus with their own colours, the cube sliding and turning, the camera moving over frames 1-4,
-# a sun. Saved as a .blend for the exporter (and a plain render) to open.
+# torus with their own colours, a cone without a material, the cube sliding and turning, the
+# camera moving over frames 1-4, a sun. Saved as a .blend for the exporter (and a plain render) to open.
 #   blender -b --factory-startup -P make_scene.py -- OUT.blend
 import math
 import sys
@@ -49,6 +49,10 @@ torus = bpy.context.active_object
 torus.name = "torus"
 bpy.ops.object.shade_smooth()
 torus.data.materials.append(material("yellow", (0.85, 0.7, 0.2)))
+
+# No material at all: the exporter gives it a default one carrying its AOVs.
+bpy.ops.mesh.primitive_cone_add(radius1=0.35, depth=0.8, location=(1.9, -0.6, 0.4))
+bpy.context.active_object.name = "cone"
 
 cam = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
 scene.collection.objects.link(cam)
