@@ -145,7 +145,7 @@ CameraAxes fit_camera_axes(const std::vector<glm::vec3>& world, const std::vecto
   const std::size_t n = world.size();
   if (n < 12)
     throw Error(file, fmt::format("only {} fully covered pixels: too few to recover the camera "
-                                  "that turns Blender's world-space normals into camera space",
+                                  "that turns world-space normals into camera space",
                                   n));
   // Hartley normalisation: centroids at the origin, mean distances sqrt(3) and sqrt(2).
   glm::dvec3 c3(0.0);
@@ -181,22 +181,22 @@ CameraAxes fit_camera_axes(const std::vector<glm::vec3>& world, const std::vecto
   // leave a second (near-)null direction.
   if (!(values[1] > 1e-8 * values[11]) || values[0] > 0.05 * values[1])
     throw Error(file,
-                "the visible points do not determine the camera (all on one plane?): "
-                "cannot turn Blender's world-space normals into camera space; render "
-                "with tools/blender/emaki_passes.py or map `normal` in source.channels");
-  // Denormalised rows of the 3x3 part: M = P_n[:, :3] * s3 with the pixel scaling undone.
+                "the visible points do not determine the camera (all on one plane?), so "
+                "world-space normals cannot be turned into camera space; render with "
+                "tools/blender/emaki_passes.py or give camera-space normals");
+  // The 3x3 part's rows in world units (the world normalisation undone). Undoing the pixel
+  // normalisation would scale rows 0 and 1 and add multiples of row 2 to them, which changes
+  // none of the directions the orthogonalisation below extracts.
   glm::dvec3 m[3];
   double m4[3];
   for (int r = 0; r < 3; ++r) {
     m[r] = glm::dvec3(vectors[r * 4][0], vectors[r * 4 + 1][0], vectors[r * 4 + 2][0]) * s3;
     m4[r] = vectors[r * 4 + 3][0];
   }
-  // Rows 0/1 are (pixel - c2) * s2 times the third; the origin shift only adds multiples of
-  // row 2, which the orthogonalisation below removes, and the scale s2 does not turn them.
-  // The third row measures depth; make it positive in front of the camera.
+  // P is known up to its sign: the third row measures depth, positive in front of the camera.
   const glm::dvec3 X0 = (glm::dvec3(world[0]) - c3) * s3;
   const double w0 = glm::dot(m[2] / s3, X0) + m4[2];
-  double sign = w0 < 0.0 ? -1.0 : 1.0;
+  const double sign = w0 < 0.0 ? -1.0 : 1.0;
   for (auto& r : m) r *= sign;
   glm::dvec3 right, down, forward;
   if (glm::length(m[2]) > 1e-6 * glm::length(m[0])) {
