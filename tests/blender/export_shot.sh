@@ -23,6 +23,7 @@ done
 "$CHECK" passes "$WORK"/renders/frame_000[1-4].exr "$WORK/reference/reference.exr"
 # The add-on: registered, its operator renders the scene's (here: first) frame.
 blender_run "$WORK/scene.blend" --python-expr "import sys, bpy
+sys.dont_write_bytecode = True
 sys.path.insert(0, '$ROOT/tools/blender')
 import emaki_passes
 emaki_passes.register()

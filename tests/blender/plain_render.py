@@ -9,6 +9,7 @@ import sys
 
 import bpy
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools",
                                 "blender"))
 import emaki_passes  # noqa: E402  (its glTF import and look-at camera)

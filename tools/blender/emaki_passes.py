@@ -154,7 +154,7 @@ def build_group(box_lo, box_size, rest_lo, rest_size, light_world):
 
     geo = n.new("ShaderNodeNewGeometry")
 
-    def vmath(op, a, b=None, value=None):
+    def vmath(op, a, b=None):
         m = n.new("ShaderNodeVectorMath")
         m.operation = op
         link(a, m.inputs[0])
