@@ -15,37 +15,11 @@
 #include "core/parallel.h"
 #include "io/shot_file.h"
 #include "io/shot_inputs.h"
+#include "memory_store.h"
 #include "pipeline/run.h"
 
-namespace {
-
-using namespace emaki;
-
-class MemoryStore : public pipeline::Store {
- public:
-  bool has_layer(const pipeline::Layer& l, int f) const override {
-    return layers_.count({l.name, f}) > 0;
-  }
-  Image<float> read_layer(const pipeline::Layer& l, int f) const override {
-    return layers_.at({l.name, f}).clone();
-  }
-  void write_layer(const pipeline::Layer& l, int f, ImageView<const float> v) override {
-    Image<float> img(v.width, v.height, v.channels);
-    for (int y = 0; y < v.height; ++y)
-      std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
-    layers_[{l.name, f}] = std::move(img);
-  }
-  bool has_frame(int) const override { return false; }
-  void write_frame(int, ImageView<const float>, const std::vector<ImageView<const float>>&,
-                   ImageView<const float>) override {}
-
- private:
-  std::map<std::pair<std::string, int>, Image<float>> layers_;
-};
-
-}  // namespace
-
 int main(int argc, char** argv) {
+  using namespace emaki;
   int width = 1920, height = 1080, frames = 3, threads = 0;
   if (argc > 1 && std::sscanf(argv[1], "%dx%d", &width, &height) != 2) {
     std::fprintf(stderr, "usage: shot_bench [WIDTHxHEIGHT] [FRAMES] [THREADS]\n");
@@ -63,7 +37,7 @@ int main(int argc, char** argv) {
     const auto source = io::open_frames(shot);
     const auto exemplars = io::load_exemplars(shot);
     const pipeline::CompositeInputs ci = io::load_composite_inputs(shot);
-    MemoryStore store;
+    bench::MemoryStore store;
     std::vector<double> seconds;
     auto t = std::chrono::steady_clock::now();
     int last = -1;

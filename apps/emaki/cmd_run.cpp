@@ -197,7 +197,7 @@ int run_qa(const Args& args) {
                   fmt::format("frame {} is not synthesized yet", f));
   const int value_channels = l->single_colour ? 1 : 3;
   std::printf("%-6s %12s %12s %12s %9s\n", "frame", "all", "objects", "ground", "pixels");
-  pipeline::FlickerStats all, objects, ground;
+  pipeline::SequenceFlicker mean;
   Image<float> prev = store.read_layer(*l, a), prev_passes = source->passes(a);
   for (int f = a + 1; f <= b; ++f) {
     Image<float> cur = store.read_layer(*l, f), cur_passes = source->passes(f);
@@ -206,18 +206,16 @@ int run_qa(const Args& args) {
         cur.cview(), prev.cview(), cur_passes.cview(), prev_passes.cview(), mask_channel);
     std::printf("%-6d %12.5f %12.5f %12.5f %9ld\n", f, ff.all.mean(), ff.objects.mean(),
                 ff.ground.mean(), ff.all.pixels);
-    // Frame means averaged with equal weight per frame.
-    all.sum += ff.all.mean(), all.pixels += 1;
-    objects.sum += ff.objects.mean(), objects.pixels += 1;
-    ground.sum += ff.ground.mean(), ground.pixels += 1;
+    mean.add(ff);
     prev = std::move(cur);
     prev_passes = std::move(cur_passes);
   }
-  std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", all.mean(), objects.mean(), ground.mean());
+  std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", mean.all.mean(), mean.objects.mean(),
+              mean.ground.mean());
   std::printf(
       "{\"layer\": \"%s\", \"frames\": [%d, %d], \"mean\": %.6f, \"objects\": %.6f, "
       "\"ground\": %.6f}\n",
-      layer.c_str(), a, b, all.mean(), objects.mean(), ground.mean());
+      layer.c_str(), a, b, mean.all.mean(), mean.objects.mean(), mean.ground.mean());
   return 0;
 }
 

@@ -18,6 +18,16 @@ struct FrameFlicker {
   FlickerStats all, objects, ground;  // objects: id >= 2; ground: id 1
 };
 
+// A sequence's flicker: the frame means averaged with equal weight per frame.
+struct SequenceFlicker {
+  FlickerStats all, objects, ground;
+  void add(const FrameFlicker& f) {
+    all.sum += f.all.mean(), all.pixels += 1;
+    objects.sum += f.objects.mean(), objects.pixels += 1;
+    ground.sum += f.ground.mean(), ground.pixels += 1;
+  }
+};
+
 // `current`/`previous`: layer values (channel 0 is used; a masked layer's coverage is its
 // channel `mask_channel`, -1 for none); passes in the layout of render/passes.h. A pixel counts
 // when it and the four pixels it samples in t-1 are fully covered, carry the same object id, no

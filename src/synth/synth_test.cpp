@@ -1,6 +1,7 @@
 // Unit tests of the synthesis engine on small synthetic images.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -236,6 +237,39 @@ TEST(Synthesize, IdentityReproducesExemplarWithZeroError) {
       for (int c = 0; c < 3; ++c) wrong += std::abs(res.image(x, y, c) - f.style(x, y, c)) > 1e-6f;
     }
   EXPECT_EQ(wrong, 0);
+}
+
+// The identity start, one level, no search: the field is the identity, clamped to the source's
+// patch centres, and scaled when the target is larger.
+TEST(Synthesize, IdentityFieldInit) {
+  Fixture f;
+  f.style = noise(40, 30, 1, 4);
+  f.guide_src = textured(40, 30, 5);
+  f.guide_tgt = textured(80, 60, 6);
+  Params params;
+  params.init = FieldInit::kIdentity;
+  params.pyramid_levels = 1;
+  params.search_vote_iters = 0;
+  OutputRequest req;
+  req.nnf = true;
+  const Result res = synthesize(f.inputs(), params, req);
+  const int r = params.patch_size / 2;
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 80; ++x) {
+      ASSERT_EQ(res.nnf(x, y, 0), std::clamp(x / 2, r, 39 - r)) << x << "," << y;
+      ASSERT_EQ(res.nnf(x, y, 1), std::clamp(y / 2, r, 29 - r)) << x << "," << y;
+    }
+  // With search, a random start would have to find the same field; the identity start keeps it.
+  params.search_vote_iters = 1;
+  params.patch_match_iters = 1;
+  params.search_radius = 2;
+  f.guide_tgt = f.guide_src.clone();
+  const Result same = synthesize(f.inputs(), params, req);
+  int moved = 0;
+  for (int y = 2 * r; y < 30 - 2 * r; ++y)
+    for (int x = 2 * r; x < 40 - 2 * r; ++x)
+      moved += same.nnf(x, y, 0) != x || same.nnf(x, y, 1) != y;
+  EXPECT_EQ(moved, 0);
 }
 
 TEST(Synthesize, BitIdenticalForAnyThreadCountAndRun) {

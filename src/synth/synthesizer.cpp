@@ -108,6 +108,7 @@ void validate(const Inputs& in, const Params& p) {
     throw Error("pyramid levels", fmt::format("must be >= 1 (got {})", p.pyramid_levels));
   if (p.search_vote_iters < -1) throw Error("search-vote iterations", "must be >= 0");
   if (p.patch_match_iters < -1) throw Error("PatchMatch iterations", "must be >= 0");
+  if (p.search_radius < 0) throw Error("search radius", "must be >= 0 (0: the whole exemplar)");
   if (!std::isfinite(p.style_weight)) throw Error("style weight", "must be finite");
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
@@ -162,7 +163,7 @@ std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
     for (auto& l : s) {
       l.search_vote_iters = p.search_vote_iters >= 0 ? p.search_vote_iters : 6;
       l.patch_match_iters = p.patch_match_iters >= 0 ? p.patch_match_iters : 4;
-      l.max_search_radius = 0;
+      l.max_search_radius = p.search_radius;
     }
     return s;
   }
@@ -286,6 +287,16 @@ Image<int32_t> upscale_nnf(const Image<int32_t>& coarse, int tw, int th, int sw,
         out(x, y, 1) = std::clamp(2 * m[1] + (y & 1), r, sh - r - 1);
       }
   });
+  return out;
+}
+
+Image<int32_t> identity_nnf(int tw, int th, int sw, int sh, int r) {
+  Image<int32_t> out(tw, th, 2);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      out(x, y, 0) = std::clamp(int((int64_t(x) * sw) / tw), r, sw - 1 - r);
+      out(x, y, 1) = std::clamp(int((int64_t(y) * sh) / th), r, sh - 1 - r);
+    }
   return out;
 }
 
@@ -445,7 +456,9 @@ Result Synthesizer::run(const OutputRequest& request) {
     Level& L = pyr[l];
     if (params.progress) params.progress(levels - 1 - l, levels);
     if (l == levels - 1)
-      nnf = random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
+      nnf = params.init == FieldInit::kIdentity
+                ? identity_nnf(L.tw, L.th, L.sw, L.sh, r)
+                : random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
     else
       nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
     err.reset(L.tw, L.th, 1);

@@ -46,6 +46,13 @@ enum class VoteMode {
   kWeighted,  // patches count 1 / (1 + their error per pixel and channel): sharper
 };
 
+// How the field starts at the coarsest level.
+enum class FieldInit {
+  kRandom,    // each target patch at a random source patch
+  kIdentity,  // target pixel (x, y) at source pixel (x, y) scaled by the size ratio: for a source
+              // and target that are nearly aligned, such as two consecutive frames (advection)
+};
+
 // Iterations at one pyramid level.
 struct LevelSchedule {
   int search_vote_iters = 6;
@@ -63,6 +70,10 @@ struct Params {
   // >= 0: that many at every level (EbSynth's behaviour; its defaults are 6 and 4).
   int search_vote_iters = -1;
   int patch_match_iters = -1;
+  // With explicit iteration counts: the random search radius in pixels at every level (0: the
+  // whole exemplar). With emaki's schedule it is chosen per level.
+  int search_radius = 0;
+  FieldInit init = FieldInit::kRandom;
   bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
   VoteMode vote_mode = VoteMode::kWeighted;
   uint64_t seed = 1;

@@ -1,5 +1,8 @@
 #include "temporal/advection.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/check.h"
 
 namespace emaki::temporal {
@@ -23,10 +26,23 @@ Image<float> advect(const AdvectionInputs& in, const synth::Params& params) {
   synth::Inputs inputs;
   inputs.style = style.cview();
   inputs.style_name = "previous frame";
-  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, in.guide_weight});
+  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, 1.0f});
   if (in.current_mask) inputs.target_mask = *in.current_mask;
   synth::Params p = params;
   p.uniformity = 0.0f;
+  // Consecutive frames are nearly aligned: the field starts at the identity and is refined at
+  // full resolution only, within a radius that covers a frame's motion.
+  p.init = synth::FieldInit::kIdentity;
+  p.pyramid_levels = 1;
+  p.search_vote_iters = 1;
+  p.patch_match_iters = 2;
+  // Matched on the position guide alone: B'(t-1) is only carried along. A style term would
+  // compare it with the current estimate of B'adv, which starts as the unmoved B'(t-1), and
+  // hold patches back where the frame moved (measured: more flicker, docs/temporal.md).
+  p.style_weight = 0.0f;
+  p.search_radius = in.search_radius > 0
+                        ? in.search_radius
+                        : std::max(8, int(std::lround(std::max(prev.width, prev.height) / 60.0)));
   synth::Result r = synth::synthesize(inputs, p);
   if (r.image.channels() == n) return std::move(r.image);
   // Drop the alpha the mask added; outside the mask the value is the empty value.

@@ -24,17 +24,22 @@ struct AdvectionInputs {
   std::string guide_name = "position";
   std::optional<ImageView<const float>> current_mask;  // where frame t is synthesized (1 ch)
   float empty_value = 1.0f;  // stands for B'(t-1) where it was not synthesized (outside its mask)
-  // Weight of the position guide against the style's 1. Position passes are smooth: at shot
-  // resolution neighbouring pixels differ by a fraction of a quantisation level, so a weight
-  // near the style's lets texture similarity outvote the motion (measured: a 4-pixel shift on
-  // a 64-pixel frame came out as 2 pixels at weight 1, exact at 10 and above).
-  float guide_weight = 1000.0f;
+  // How far, in pixels, a point may move between the two frames and still be found by the
+  // random search (propagation carries matches further); 0: the larger frame side / 60 (16 at
+  // 960x540, 32 at 1920x1080), at least 8.
+  int search_radius = 0;
 };
 
 // B'adv, the size of the current frame, `value_channels` channels. `params` are the layer's
-// synthesis settings (the seed should differ from the main transfer's); the uniformity term is
-// turned off, because an advection is a warp: spreading the use of B'(t-1)'s patches evenly
-// would pull them off the motion.
+// synthesis settings (patch size, seed — which should differ from the main transfer's); the
+// uniformity term is turned off, because an advection is a warp: spreading the use of
+// B'(t-1)'s patches evenly would pull them off the motion; for the same reason patches are
+// matched on the position guide alone (style weight 0). The schedule is the advection's own:
+// the field starts at the identity (the two frames are nearly aligned) and one search-vote
+// iteration of two PatchMatch sweeps at full resolution, random search within
+// `search_radius`, refines it. Measured on the example against the main transfer's multiscale
+// schedule with a style weight of 1 against the guide's 1000: less flicker and a third of the
+// advection's time (docs/temporal.md).
 Image<float> advect(const AdvectionInputs& in, const synth::Params& params);
 
 }  // namespace emaki::temporal

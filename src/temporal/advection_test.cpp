@@ -55,6 +55,26 @@ TEST(Advection, CarriesThePreviousFrameAlongThePositionGuide) {
   EXPECT_LT(moved, 0.3 * unmoved);
 }
 
+// A larger motion than the default radius covers at this size is found with a radius that does.
+TEST(Advection, FindsMotionWithinTheSearchRadius) {
+  const int w = 96, h = 64;
+  const Image<float> prev = stripes(w, h, 0.0f);
+  const Image<float> g_prev = position_guide(w, h, 0.0f), g_cur = position_guide(w, h, 12.0f);
+  AdvectionInputs in;
+  in.previous_stylized = prev.cview();
+  in.previous_guide = g_prev.cview();
+  in.current_guide = g_cur.cview();
+  in.search_radius = 16;
+  const Image<float> adv = advect(in, synth::Params{});
+  const Image<float> expected = stripes(w, h, 12.0f);
+  // Where the moved content exists in the previous frame (x + 12 < w), it is carried exactly.
+  double s = 0;
+  int n = 0;
+  for (int y = 6; y < h - 6; ++y)
+    for (int x = 6; x < w - 12 - 6; ++x) s += std::abs(adv(x, y) - expected(x, y)), ++n;
+  EXPECT_LT(s / n, 0.03);
+}
+
 // Outside its mask the previous frame had nothing; the advection reads the empty value there.
 TEST(Advection, MaskedPreviousFrameUsesTheEmptyValue) {
   const int w = 48, h = 32;
