@@ -85,10 +85,11 @@ TEST(PatchDistance, ExactForLargestDifferences) {
   EXPECT_EQ(patch_ssd_scalar(a.data(), row_elems, b.data(), row_elems, row_elems, patch,
                              std::numeric_limits<int64_t>::max()),
             expect);
-  if (cpu_has_avx2())
+  if (cpu_has_avx2()) {
     EXPECT_EQ(patch_ssd_avx2(a.data(), row_elems, b.data(), row_elems, row_elems, patch,
                              std::numeric_limits<int64_t>::max()),
               expect);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -321,9 +322,13 @@ TEST(Synthesize, MaskLeavesOutsideTransparent) {
     for (int x = 0; x < 48; ++x) {
       const bool inside = mask(x, y) > 0.0f;
       EXPECT_EQ(res.image(x, y, 1), inside ? 1.0f : 0.0f);
-      if (!inside) EXPECT_EQ(res.image(x, y, 0), 0.0f);
+      if (!inside) {
+        EXPECT_EQ(res.image(x, y, 0), 0.0f);
+      }
       const bool far = x < 8 || x > 39 || y < 6 || y > 33;  // beyond the dilated mask
-      if (far) EXPECT_EQ(res.nnf(x, y, 0), -1);
+      if (far) {
+        EXPECT_EQ(res.nnf(x, y, 0), -1);
+      }
     }
 }
 
