@@ -104,7 +104,13 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
                              advected.cview(), l.temporal.weight});
   }
   if (!mask.empty()) inputs.target_mask = mask.cview();
-  synth::Result r = synth::synthesize(inputs, synth_params(l.synth, frame_seed(l, frame, 0)));
+  synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
+  // With a temporal guide, B'adv already carries the previous frame's converged texture: one
+  // search-vote iteration at the finest level instead of two keeps flicker and the judge's
+  // style energy within their bars (measured on the example, docs/temporal.md) and saves about
+  // a quarter of the time per frame.
+  if (!advected.empty()) params.finest_search_vote_iters = 1;
+  synth::Result r = synth::synthesize(inputs, params);
   return std::move(r.image);
 }
 

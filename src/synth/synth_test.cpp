@@ -240,6 +240,23 @@ TEST(Synthesize, IdentityReproducesExemplarWithZeroError) {
   EXPECT_EQ(wrong, 0);
 }
 
+// The finest level's search-vote count can be lowered alone (temporal frames use 1).
+TEST(Schedule, FinestSearchVoteItersOverridesOnlyTheFinestLevel) {
+  Params p;
+  const std::vector<LevelSchedule> base = make_schedule(p, 6);
+  p.finest_search_vote_iters = 1;
+  const std::vector<LevelSchedule> lean = make_schedule(p, 6);
+  ASSERT_EQ(base.size(), 6u);
+  ASSERT_EQ(lean.size(), 6u);
+  EXPECT_EQ(base.back().search_vote_iters, 2);
+  EXPECT_EQ(lean.back().search_vote_iters, 1);
+  for (std::size_t l = 0; l + 1 < base.size(); ++l) {
+    EXPECT_EQ(lean[l].search_vote_iters, base[l].search_vote_iters) << l;
+    EXPECT_EQ(lean[l].patch_match_iters, base[l].patch_match_iters) << l;
+    EXPECT_EQ(lean[l].max_search_radius, base[l].max_search_radius) << l;
+  }
+}
+
 // The identity start, one level, no search: the field is the identity, clamped to the source's
 // patch centres, and scaled when the target is larger.
 TEST(Synthesize, IdentityFieldInit) {

@@ -177,7 +177,7 @@ std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
   for (int l = 0; l < levels; ++l) {
     const int from_finest = levels - 1 - l;
     if (from_finest == 0)
-      s[l] = {2, 2, 32};
+      s[l] = {p.finest_search_vote_iters >= 0 ? p.finest_search_vote_iters : 2, 2, 32};
     else if (from_finest == 1)
       s[l] = {2, 3, 32};
     else if (from_finest == 2)

@@ -74,6 +74,8 @@ struct Params {
   // whole exemplar). With emaki's schedule it is chosen per level.
   int search_radius = 0;
   FieldInit init = FieldInit::kRandom;
+  // emaki's schedule only: search-vote iterations at the finest level (-1: the schedule's 2).
+  int finest_search_vote_iters = -1;
   bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
   VoteMode vote_mode = VoteMode::kWeighted;
   uint64_t seed = 1;
