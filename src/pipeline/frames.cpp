@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "exemplar/reference_sphere.h"
 #include "render/passes.h"
 #include "render/renderer.h"
@@ -26,21 +28,32 @@ class SceneFrames : public FrameSource {
 };
 
 // Grows a binary mask by a disc of `radius` pixels (separable would be a square; a disc keeps
-// line masks round at their ends).
+// line masks round at their ends). Each output row gathers from the rows within reach, so
+// bands of rows run in parallel.
 Image<float> dilate(const Image<float>& m, float radius) {
   if (radius <= 0.0f) return m.clone();
   const int r = int(std::ceil(radius));
-  Image<float> out(m.width(), m.height(), 1);
-  for (int y = 0; y < m.height(); ++y)
-    for (int x = 0; x < m.width(); ++x) {
-      if (m(x, y) <= 0.5f) continue;
-      for (int dy = -r; dy <= r; ++dy)
-        for (int dx = -r; dx <= r; ++dx) {
-          if (dx * dx + dy * dy > radius * radius) continue;
-          const int xx = x + dx, yy = y + dy;
-          if (xx >= 0 && yy >= 0 && xx < m.width() && yy < m.height()) out(xx, yy) = 1.0f;
+  const int w = m.width(), h = m.height();
+  // Per row offset dy, the half-width of the disc.
+  std::vector<int> half(2 * r + 1);
+  for (int dy = -r; dy <= r; ++dy) {
+    int hw = -1;
+    for (int dx = 0; dx <= r; ++dx)
+      if (float(dx * dx + dy * dy) <= radius * radius) hw = dx;
+    half[dy + r] = hw;
+  }
+  Image<float> out(w, h, 1);
+  parallel_rows(h, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int dy = -r; dy <= r; ++dy) {
+        const int yy = y + dy, hw = half[dy + r];
+        if (yy < 0 || yy >= h || hw < 0) continue;
+        for (int x = 0; x < w; ++x) {
+          if (m(x, yy) <= 0.5f) continue;
+          for (int xx = std::max(0, x - hw); xx <= std::min(w - 1, x + hw); ++xx) out(xx, y) = 1.0f;
         }
-    }
+      }
+  });
   return out;
 }
 
@@ -53,9 +66,11 @@ std::unique_ptr<FrameSource> scene_frames(scene::Scene scene, const Source& sour
 Image<float> extract(ImageView<const float> passes, int first, int count) {
   CHECK_LE(first + count, passes.channels);
   Image<float> out(passes.width, passes.height, count);
-  for (int y = 0; y < passes.height; ++y)
-    for (int x = 0; x < passes.width; ++x)
-      for (int c = 0; c < count; ++c) out(x, y, c) = passes(x, y, first + c);
+  parallel_rows(passes.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < passes.width; ++x)
+        for (int c = 0; c < count; ++c) out(x, y, c) = passes(x, y, first + c);
+  });
   return out;
 }
 
@@ -68,36 +83,38 @@ Image<float> extract_pass(ImageView<const float> passes, const std::string& name
 Image<float> layer_mask(ImageView<const float> passes, const MaskSpec& spec) {
   if (spec.kind == MaskKind::kNone) return {};
   Image<float> m(passes.width, passes.height, 1);
-  for (int y = 0; y < passes.height; ++y)
-    for (int x = 0; x < passes.width; ++x) {
-      const float* p = passes.at(x, y);
-      const bool covered = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 1.0f;
-      // In shadow: cast shadow, or the surface turned away from the key light.
-      const bool shadowed =
-          covered && (p[render::kShadow] > spec.threshold || p[render::kDiffuse] < 0.1f);
-      bool in = false;
-      switch (spec.kind) {
-        case MaskKind::kNone:
-          in = true;
-          break;
-        case MaskKind::kCovered:
-          in = covered;
-          break;
-        case MaskKind::kObjects:
-          in = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 2.0f;
-          break;
-        case MaskKind::kLines:
-          in = p[render::kOutline] > spec.threshold;
-          break;
-        case MaskKind::kShadow:
-          in = shadowed;
-          break;
-        case MaskKind::kLit:
-          in = covered && !shadowed;
-          break;
+  parallel_rows(passes.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < passes.width; ++x) {
+        const float* p = passes.at(x, y);
+        const bool covered = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 1.0f;
+        // In shadow: cast shadow, or the surface turned away from the key light.
+        const bool shadowed =
+            covered && (p[render::kShadow] > spec.threshold || p[render::kDiffuse] < 0.1f);
+        bool in = false;
+        switch (spec.kind) {
+          case MaskKind::kNone:
+            in = true;
+            break;
+          case MaskKind::kCovered:
+            in = covered;
+            break;
+          case MaskKind::kObjects:
+            in = p[render::kAlpha] > 0.5f && p[render::kObjectId] >= 2.0f;
+            break;
+          case MaskKind::kLines:
+            in = p[render::kOutline] > spec.threshold;
+            break;
+          case MaskKind::kShadow:
+            in = shadowed;
+            break;
+          case MaskKind::kLit:
+            in = covered && !shadowed;
+            break;
+        }
+        m(x, y) = in ? 1.0f : 0.0f;
       }
-      m(x, y) = in ? 1.0f : 0.0f;
-    }
+  });
   return dilate(m, spec.dilate);
 }
 
@@ -119,15 +136,17 @@ Image<float> advection_guide(ImageView<const float> passes, AdvectionGuide guide
   const bool rest = guide == AdvectionGuide::kRestPosition;
   const int first = rest ? render::kRestPosition : render::kPositionNorm;
   Image<float> out(passes.width, passes.height, rest ? 4 : 3);
-  for (int y = 0; y < passes.height; ++y)
-    for (int x = 0; x < passes.width; ++x) {
-      const float* p = passes.at(x, y);
-      float* o = out.at(x, y);
-      for (int c = 0; c < 3; ++c) o[c] = p[first + c];
-      // Ids are small integers (0 background, 1 ground, 2.. objects); the engine normalises a
-      // float guide by its range, so different objects end up far apart in patch space.
-      if (rest) o[3] = p[render::kObjectId];
-    }
+  parallel_rows(passes.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < passes.width; ++x) {
+        const float* p = passes.at(x, y);
+        float* o = out.at(x, y);
+        for (int c = 0; c < 3; ++c) o[c] = p[first + c];
+        // Ids are small integers (0 background, 1 ground, 2.. objects); the engine normalises
+        // a float guide by its range, so different objects end up far apart in patch space.
+        if (rest) o[3] = p[render::kObjectId];
+      }
+  });
   return out;
 }
 

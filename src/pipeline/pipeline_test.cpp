@@ -112,6 +112,24 @@ TEST(Pipeline, LineMaskIsDilated) {
   EXPECT_TRUE(layer_mask(p.cview(), {MaskKind::kNone, 0.0f, 0.5f}).empty());
 }
 
+// The dilation is a disc: every pixel within `radius` of a line pixel, and no other.
+TEST(Pipeline, MaskDilationIsADisc) {
+  const int w = 37, h = 29;
+  Image<float> p(w, h, render::kChannelCount);
+  std::vector<std::pair<int, int>> lines = {{3, 4}, {18, 14}, {35, 27}, {0, 28}, {20, 15}};
+  for (auto [x, y] : lines) p(x, y, render::kOutline) = 1.0f;
+  for (float radius : {1.0f, 1.5f, 2.0f, 3.3f}) {
+    const Image<float> m = layer_mask(p.cview(), {MaskKind::kLines, radius, 0.5f});
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        bool near = false;
+        for (auto [lx, ly] : lines)
+          near |= float((x - lx) * (x - lx) + (y - ly) * (y - ly)) <= radius * radius;
+        ASSERT_EQ(m(x, y), near ? 1.0f : 0.0f) << x << "," << y << " radius " << radius;
+      }
+  }
+}
+
 TEST(Pipeline, FlickerFollowsMotion) {
   const SlidingFrames f(40, 30);
   const Image<float> p0 = f.passes(0), p1 = f.passes(1);
