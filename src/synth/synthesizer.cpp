@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <mutex>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -59,19 +61,36 @@ void for_each_row(const Plane& plane, int y0, int y1, Fn&& fn) {
       plane);
 }
 
+// Min and max are exact and order-free, so bands may combine in any order.
 void plane_range(const Plane& p, int c, float& lo, float& hi) {
-  for_each_row(p, 0, plane_height(p), [&](int, const float* row) {
-    const int nc = plane_channels(p);
-    for (int x = 0; x < plane_width(p); ++x) {
-      lo = std::min(lo, row[x * nc + c]);
-      hi = std::max(hi, row[x * nc + c]);
-    }
+  std::mutex m;
+  const float lo0 = lo, hi0 = hi;
+  parallel_rows(plane_height(p), 32, [&](int y0, int y1) {
+    float l = lo0, h = hi0;
+    const int nc = plane_channels(p), w = plane_width(p);
+    for_each_row(p, y0, y1, [&](int, const float* row) {
+      for (int x = 0; x < w; ++x) {
+        l = std::min(l, row[x * nc + c]);
+        h = std::max(h, row[x * nc + c]);
+      }
+    });
+    std::lock_guard lock(m);
+    lo = std::min(lo, l);
+    hi = std::max(hi, h);
   });
 }
 
 void check_finite(const Plane& p, const std::string& name) {
   if (!is_float(p)) return;
   const auto& v = std::get<2>(p);
+  std::atomic<bool> bad{false};
+  parallel_rows(v.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1 && !bad.load(std::memory_order_relaxed); ++y)
+      for (int i = 0; i < v.width * v.channels; ++i)
+        if (!std::isfinite(v.row(y)[i])) bad.store(true, std::memory_order_relaxed);
+  });
+  if (!bad) return;
+  // Name the first bad pixel in row order, whichever band found one.
   for (int y = 0; y < v.height; ++y)
     for (int i = 0; i < v.width * v.channels; ++i)
       if (!std::isfinite(v.row(y)[i]))
@@ -366,21 +385,25 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
     if (in.target_mask) {
       // Synthesize the mask dilated by the patch radius, so pixels at its edge get whole patches.
       Image<uint8_t> inside(tw, th, 1);
-      for_each_row(*in.target_mask, 0, th, [&](int y, const float* row) {
-        const int mc = plane_channels(*in.target_mask);
-        for (int x = 0; x < tw; ++x) inside(x, y) = row[x * mc] > 0.0f ? 1 : 0;
+      const int mc = plane_channels(*in.target_mask);
+      parallel_rows(th, 32, [&](int y0, int y1) {
+        for_each_row(*in.target_mask, y0, y1, [&](int y, const float* row) {
+          for (int x = 0; x < tw; ++x) inside(x, y) = row[x * mc] > 0.0f ? 1 : 0;
+        });
       });
       f.active.reset(tw, th, 1);
-      for (int y = 0; y < th; ++y)
-        for (int x = 0; x < tw; ++x) {
-          uint8_t v = 0;
-          for (int dy = -r; dy <= r && !v; ++dy)
-            for (int dx = -r; dx <= r && !v; ++dx) {
-              const int xx = x + dx, yy = y + dy;
-              if (xx >= 0 && xx < tw && yy >= 0 && yy < th) v = inside(xx, yy);
-            }
-          f.active(x, y) = v;
-        }
+      parallel_rows(th, 32, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+          for (int x = 0; x < tw; ++x) {
+            uint8_t v = 0;
+            for (int dy = -r; dy <= r && !v; ++dy)
+              for (int dx = -r; dx <= r && !v; ++dx) {
+                const int xx = x + dx, yy = y + dy;
+                if (xx >= 0 && xx < tw && yy >= 0 && yy < th) v = inside(xx, yy);
+              }
+            f.active(x, y) = v;
+          }
+      });
     }
   }
 }
@@ -475,12 +498,13 @@ Result Synthesizer::run(const OutputRequest& request) {
   const Level& F = pyr[0];
   const int out_c = ns + (st.mask ? 1 : 0);
   res.image.reset(tw, th, out_c);
-  for (int y = 0; y < th; ++y)
-    for (int x = 0; x < tw; ++x)
-      for (int c = 0; c < ns; ++c) res.image(x, y, c) = style(x, y, c);
-  if (st.mask) {
-    for_each_row(*st.mask, 0, th, [&](int y, const float* row) {
-      const int mc = plane_channels(*st.mask);
+  parallel_rows(th, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < tw; ++x)
+        for (int c = 0; c < ns; ++c) res.image(x, y, c) = style(x, y, c);
+    if (!st.mask) return;
+    const int mc = plane_channels(*st.mask);
+    for_each_row(*st.mask, y0, y1, [&](int y, const float* row) {
       for (int x = 0; x < tw; ++x) {
         const float a = std::clamp(row[x * mc], 0.0f, 1.0f);
         res.image(x, y, ns) = a;
@@ -488,7 +512,7 @@ Result Synthesizer::run(const OutputRequest& request) {
           for (int c = 0; c < ns; ++c) res.image(x, y, c) = 0.0f;
       }
     });
-  }
+  });
   if (request.nnf) {
     res.nnf.reset(tw, th, 2);
     for (int y = 0; y < th; ++y)
