@@ -1,12 +1,15 @@
 // emaki: parse -> load -> pipeline -> report. Only this layer decides exit codes.
 #include <malloc.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 
 #include "apps/emaki/commands.h"
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace emaki::app {
 
@@ -43,19 +46,37 @@ int main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   const std::string name = argv[1];
-  Args args(argv + 2, argv + argc);
+  // `--max-pixels N` is global: the pixel budget every image read or allocated is checked
+  // against before allocation (default 2^28). It may stand anywhere after the command.
+  Args args;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a != "--max-pixels") {
+      args.push_back(a);
+      continue;
+    }
+    char* end = nullptr;
+    const char* v = i + 1 < argc ? argv[i + 1] : "";
+    errno = 0;
+    const long long n = std::strtoll(v, &end, 10);
+    if (*v == '\0' || *end != '\0' || errno != 0 || n < 1) {
+      std::fprintf(stderr, "emaki %s: error: --max-pixels: expected a positive integer, got '%s'\n",
+                   name.c_str(), emaki::echo(v).c_str());
+      return 1;
+    }
+    emaki::set_max_pixels(n);
+    ++i;
+  }
   for (const auto& c : commands()) {
     if (name != c.name) continue;
     try {
       return c.run(args);
-    } catch (const emaki::Error& e) {
-      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, e.what());
-      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "emaki %s: error: %s\n", c.name, e.what());
       return 1;
     }
   }
-  std::fprintf(stderr, "emaki: error: unknown command '%s' (see 'emaki --help')\n", name.c_str());
+  std::fprintf(stderr, "emaki: error: unknown command '%s' (see 'emaki --help')\n",
+               emaki::echo(name).c_str());
   return 2;
 }

@@ -1,0 +1,79 @@
+// Limits on what a file or an option may ask emaki to allocate or loop over, and checked
+// arithmetic for every size, count, offset and frame number that comes from outside.
+// Files come from other people and run unattended on a farm: a header that claims
+// 100000x100000 pixels must fail from the header, before any allocation.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "core/error.h"
+
+namespace emaki {
+
+// Default pixel budget per image: 2^28 pixels (16384 x 16384), 4 GiB as float RGBA.
+inline constexpr int64_t kDefaultMaxPixels = int64_t(1) << 28;
+
+namespace detail {
+inline std::atomic<int64_t>& max_pixels_slot() {
+  static std::atomic<int64_t> v{kDefaultMaxPixels};
+  return v;
+}
+}  // namespace detail
+
+// The process-wide pixel budget (`--max-pixels` on the CLI, `limits.max_pixels` in a shot).
+inline int64_t max_pixels() { return detail::max_pixels_slot().load(std::memory_order_relaxed); }
+inline void set_max_pixels(int64_t n) {
+  detail::max_pixels_slot().store(n, std::memory_order_relaxed);
+}
+
+// Overflow-checked arithmetic: nullopt when the exact result does not fit in T.
+template <typename T>
+std::optional<T> checked_mul(T a, T b) {
+  T r;
+  if (__builtin_mul_overflow(a, b, &r)) return std::nullopt;
+  return r;
+}
+template <typename T>
+std::optional<T> checked_add(T a, T b) {
+  T r;
+  if (__builtin_add_overflow(a, b, &r)) return std::nullopt;
+  return r;
+}
+
+// A user value shown in an error line, cut to `cap` bytes: a 100 MB clip name must not be
+// echoed whole. Control characters are shown as '?'.
+inline std::string echo(std::string_view value, std::size_t cap = 80) {
+  std::string out;
+  const std::size_t n = value.size() < cap ? value.size() : cap;
+  out.reserve(n + 16);
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned char c = static_cast<unsigned char>(value[i]);
+    out += (c < 0x20 || c == 0x7f) ? '?' : char(c);
+  }
+  if (value.size() > cap) out += "... (" + std::to_string(value.size()) + " bytes)";
+  return out;
+}
+
+// Throws Error(subject) when width x height is not a positive size within the pixel budget.
+// Call it with the sizes a header claims, before allocating anything.
+inline void check_pixel_budget(const std::string& subject, int64_t width, int64_t height) {
+  if (width <= 0 || height <= 0)
+    throw Error(subject, "image size " + std::to_string(width) + "x" + std::to_string(height) +
+                             " is not positive");
+  const auto n = checked_mul<int64_t>(width, height);
+  if (!n || *n > max_pixels())
+    throw Error(subject, "image size " + std::to_string(width) + "x" + std::to_string(height) +
+                             " exceeds the pixel budget of " + std::to_string(max_pixels()) +
+                             " pixels (raise it with --max-pixels or limits.max_pixels)");
+  if (width > std::numeric_limits<int>::max() / 4 || height > std::numeric_limits<int>::max() / 4)
+    throw Error(subject, "image size " + std::to_string(width) + "x" + std::to_string(height) +
+                             " is too large");
+}
+
+}  // namespace emaki
