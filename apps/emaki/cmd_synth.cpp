@@ -12,6 +12,7 @@
 #include <string>
 
 #include "apps/emaki/commands.h"
+#include "apps/emaki/synth_args.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
@@ -58,83 +59,6 @@ emaki options
   --help                this text
 )";
 
-struct GuideArg {
-  std::string source, target;
-  float weight = -1.0f;
-};
-
-int parse_int(const std::string& opt, const std::string& v) {
-  try {
-    std::size_t pos = 0;
-    const int n = std::stoi(v, &pos);
-    if (pos != v.size()) throw std::invalid_argument(v);
-    return n;
-  } catch (const std::exception&) {
-    throw Error(opt, "expects an integer, got '" + v + "'");
-  }
-}
-
-float parse_float(const std::string& opt, const std::string& v) {
-  try {
-    std::size_t pos = 0;
-    const float f = std::stof(v, &pos);
-    if (pos != v.size() || !std::isfinite(f)) throw std::invalid_argument(v);
-    return f;
-  } catch (const std::exception&) {
-    throw Error(opt, "expects a number, got '" + v + "'");
-  }
-}
-
-// EbSynth counts an RGB image whose three channels are equal everywhere as one channel, and
-// drops an alpha channel that is opaque everywhere.
-int effective_channels(const io::AnyImage& im) {
-  const int nc = im.channels();
-  const int w = im.width(), h = im.height();
-  auto opaque = [&](int c) {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        if (im.value(x, y, c) != 1.0f) return false;
-    return true;
-  };
-  auto gray = [&]() {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const float r = im.value(x, y, 0);
-        if (im.value(x, y, 1) != r || im.value(x, y, 2) != r) return false;
-      }
-    return true;
-  };
-  if (nc == 4) return opaque(3) ? (gray() ? 1 : 3) : 4;
-  if (nc == 3) return gray() ? 1 : 3;
-  if (nc == 2) return opaque(1) ? 1 : 2;
-  return nc;
-}
-
-// Gives an image `channels` channels: keeps the first ones (effective_channels only drops
-// trailing ones), or spreads a gray image over RGB when its partner guide is in colour.
-io::AnyImage reduce(io::AnyImage im, int channels) {
-  const int have = im.channels();
-  if (have == channels) return im;
-  if (have > channels) return im.select_channels(0, channels);
-  io::AnyImage out;
-  std::visit(
-      [&](const auto& src) {
-        using T = std::decay_t<decltype(src(0, 0))>;
-        Image<T> o(src.width(), src.height(), channels);
-        const bool gray = have <= 2;
-        for (int y = 0; y < src.height(); ++y)
-          for (int x = 0; x < src.width(); ++x)
-            for (int c = 0; c < channels; ++c) {
-              int from = std::min(c, have - 1);
-              if (gray) from = c < 3 ? 0 : have - 1;
-              o(x, y, c) = src(x, y, from);
-            }
-        out.image = std::move(o);
-      },
-      im.image);
-  return out;
-}
-
 synth::Plane plane_of(const io::AnyImage& im) {
   return std::visit([](const auto& i) -> synth::Plane { return i.view(); }, im.image);
 }
@@ -149,112 +73,27 @@ void check_output_path(const std::string& opt, const std::string& path) {
 
 }  // namespace
 
-int run_synth(const Args& args) {
-  std::string style_path, output = "output.png", mask_path, nnf_out, error_out, depth;
-  float style_weight = -1.0f;
-  std::vector<GuideArg> guides;
-  synth::Params params;
-  int threads = 0;
-  bool quiet = false;
-  float* last_weight = nullptr;
-
-  auto need = [&](std::size_t& i, const std::string& opt) -> const std::string& {
-    if (i + 1 >= args.size()) throw Error(opt, "is missing its value");
-    return args[++i];
-  };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    } else if (a == "-style") {
-      style_path = need(i, a);
-      last_weight = &style_weight;
-    } else if (a == "-guide") {
-      GuideArg g;
-      if (i + 2 >= args.size() || args[i + 1].rfind("-", 0) == 0 || args[i + 2].rfind("-", 0) == 0)
-        throw Error("-guide", "needs two paths: the source guide and the target guide");
-      g.source = args[++i];
-      g.target = args[++i];
-      guides.push_back(g);
-      last_weight = &guides.back().weight;
-    } else if (a == "-weight") {
-      const float w = parse_float(a, need(i, a));
-      if (!last_weight) throw Error("-weight", "must follow a -style or -guide option");
-      if (w < 0.0f) throw Error("-weight", "must be >= 0");
-      *last_weight = w;
-    } else if (a == "-output") {
-      output = need(i, a);
-    } else if (a == "-uniformity") {
-      params.uniformity = parse_float(a, need(i, a));
-      if (params.uniformity < 0.0f) throw Error(a, "must be >= 0");
-    } else if (a == "-patchsize") {
-      params.patch_size = parse_int(a, need(i, a));
-      if (params.patch_size < 3)
-        throw Error(a, fmt::format("must be >= 3 (got {})", params.patch_size));
-      if (params.patch_size % 2 == 0)
-        throw Error(a, fmt::format("must be odd (got {})", params.patch_size));
-    } else if (a == "-pyramidlevels") {
-      params.pyramid_levels = parse_int(a, need(i, a));
-      if (params.pyramid_levels < 1) throw Error(a, "must be >= 1");
-    } else if (a == "-searchvoteiters") {
-      params.search_vote_iters = parse_int(a, need(i, a));
-      if (params.search_vote_iters < 0) throw Error(a, "must be >= 0");
-    } else if (a == "-patchmatchiters") {
-      params.patch_match_iters = parse_int(a, need(i, a));
-      if (params.patch_match_iters < 0) throw Error(a, "must be >= 0");
-    } else if (a == "-stopthreshold") {
-      if (parse_int(a, need(i, a)) < 0) throw Error(a, "must be >= 0");
-    } else if (a == "-extrapass3x3") {
-      params.extra_pass_3x3 = true;
-    } else if (a == "-backend") {
-      const std::string b = need(i, a);
-      if (b != "cpu" && b != "cuda" && b != "auto")
-        throw Error(a, "must be cpu, cuda or auto (got '" + b + "')");
-    } else if (a == "--seed") {
-      const std::string v = need(i, a);
-      try {
-        std::size_t pos = 0;
-        params.seed = std::stoull(v, &pos);
-        if (pos != v.size()) throw std::invalid_argument(v);
-      } catch (const std::exception&) {
-        throw Error(a, "expects a non-negative integer, got '" + v + "'");
-      }
-    } else if (a == "--threads") {
-      threads = parse_int(a, need(i, a));
-      if (threads < 0) throw Error(a, "must be >= 0");
-    } else if (a == "--mask") {
-      mask_path = need(i, a);
-    } else if (a == "--vote") {
-      const std::string v = need(i, a);
-      if (v == "plain")
-        params.vote_mode = synth::VoteMode::kPlain;
-      else if (v == "weighted")
-        params.vote_mode = synth::VoteMode::kWeighted;
-      else
-        throw Error(a, "must be plain or weighted (got '" + v + "')");
-    } else if (a == "--nnf-out") {
-      nnf_out = need(i, a);
-    } else if (a == "--error-out") {
-      error_out = need(i, a);
-    } else if (a == "--output-depth") {
-      depth = need(i, a);
-      if (depth != "8" && depth != "16" && depth != "float")
-        throw Error(a, "must be 8, 16 or float (got '" + depth + "')");
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else {
-      throw Error(a, "unknown option (see 'emaki synth --help')");
-    }
+int run_synth(const Args& argv) {
+  const SynthArgs args = parse_synth_args(argv);
+  if (args.help) {
+    std::fputs(kHelp, stdout);
+    return 0;
   }
-  if (style_path.empty()) throw Error("-style", "is required (the style exemplar)");
-  if (guides.empty()) throw Error("-guide", "at least one guide pair is required");
+  const std::string& style_path = args.style_path;
+  const std::string& output = args.output;
+  const std::string& mask_path = args.mask_path;
+  const std::string& nnf_out = args.nnf_out;
+  const std::string& error_out = args.error_out;
+  const std::string& depth = args.depth;
+  const std::vector<SynthGuideArg>& guides = args.guides;
+  synth::Params params = args.params;
+  const bool quiet = args.quiet;
 
   // Fail on an unwritable output before any long work.
   check_output_path("-output", output);
   if (!nnf_out.empty()) check_output_path("--nnf-out", nnf_out);
   if (!error_out.empty()) check_output_path("--error-out", error_out);
-  set_thread_count(threads);
+  set_thread_count(args.threads);
 
   const auto t0 = std::chrono::steady_clock::now();
   // Decode every file at once (PNG decoding is serial per file); report the first failure in
@@ -275,7 +114,7 @@ int run_synth(const Args& args) {
   for (const auto& f : failures)
     if (f) std::rethrow_exception(f);
   io::AnyImage style = std::move(files[0]);
-  style = reduce(std::move(style), effective_channels(style));
+  style = with_channels(std::move(style), effective_channels(style));
   if (style.channels() > 4) throw Error(style_path, "style must have 1 to 4 channels");
 
   std::vector<io::AnyImage> loaded;
@@ -284,7 +123,7 @@ int run_synth(const Args& args) {
   in.style = plane_of(style);
   in.style_name = style_path;
   for (std::size_t k = 0; k < guides.size(); ++k) {
-    const GuideArg& g = guides[k];
+    const SynthGuideArg& g = guides[k];
     io::AnyImage s = std::move(files[1 + 2 * k]);
     io::AnyImage t = std::move(files[2 + 2 * k]);
     if (s.width() != style.width() || s.height() != style.height())
@@ -293,8 +132,8 @@ int run_synth(const Args& args) {
                               s.height(), style_path, style.width(), style.height()));
     const int nc = std::max(effective_channels(s), effective_channels(t));
     if (nc > 4) throw Error(g.source, "a guide must have 1 to 4 channels");
-    loaded.push_back(reduce(std::move(s), std::min(nc, 4)));
-    loaded.push_back(reduce(std::move(t), std::min(nc, 4)));
+    loaded.push_back(with_channels(std::move(s), std::min(nc, 4)));
+    loaded.push_back(with_channels(std::move(t), std::min(nc, 4)));
     const io::AnyImage& ls = loaded[loaded.size() - 2];
     const io::AnyImage& lt = loaded.back();
     if (ls.channels() != lt.channels())
@@ -323,7 +162,7 @@ int run_synth(const Args& args) {
     in.target_mask = plane_of(mask);
     in.target_mask_name = mask_path;
   }
-  params.style_weight = style_weight;
+  params.style_weight = args.style_weight;
 
   synth::OutputRequest req;
   req.nnf = !nnf_out.empty();

@@ -1,0 +1,105 @@
+// `emaki synth`'s parser alone (no files) and EbSynth's channel rules.
+#include "apps/emaki/synth_args.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/error.h"
+
+namespace emaki::app {
+namespace {
+
+std::string error_of(const std::vector<std::string>& args) {
+  try {
+    parse_synth_args(args);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SynthArgs, EbSynthCommandLine) {
+  const SynthArgs a = parse_synth_args({"-style", "s.png", "-weight", "2", "-guide", "a.png",
+                                        "b.png", "-weight", "0.5", "-guide", "c.png", "d.png",
+                                        "-output", "o.png", "-patchsize", "7", "-uniformity",
+                                        "1000", "-extrapass3x3"});
+  EXPECT_EQ(a.style_path, "s.png");
+  EXPECT_EQ(a.style_weight, 2.0f);
+  ASSERT_EQ(a.guides.size(), 2u);
+  EXPECT_EQ(a.guides[0].weight, 0.5f);
+  EXPECT_EQ(a.guides[1].weight, -1.0f);
+  EXPECT_EQ(a.guides[1].target, "d.png");
+  EXPECT_EQ(a.output, "o.png");
+  EXPECT_EQ(a.params.patch_size, 7);
+  EXPECT_EQ(a.params.uniformity, 1000.0f);
+  EXPECT_TRUE(a.params.extra_pass_3x3);
+}
+
+TEST(SynthArgs, ErrorsNameTheOption) {
+  const std::vector<std::string> base{"-style", "s.png", "-guide", "a.png", "b.png"};
+  struct Case {
+    std::vector<std::string> extra;
+    std::string starts;
+  } cases[] = {
+      {{"-patchsize", "4"}, "-patchsize: must be odd"},
+      {{"-patchsize", "2147483647"}, "-patchsize: must be <= 65"},
+      {{"-patchsize", "99999999999999"}, "-patchsize: expects an integer"},
+      {{"-searchvoteiters", "2000000000"}, "-searchvoteiters: must be in [0, 1000]"},
+      {{"-patchmatchiters", "-1"}, "-patchmatchiters: must be in [0, 1000]"},
+      {{"-pyramidlevels", "33"}, "-pyramidlevels: must be in [1, 32]"},
+      {{"--threads", "100000"}, "--threads: must be in [0, 1024]"},
+      {{"-uniformity", "nan"}, "-uniformity: expects a number"},
+      {{"-weight", "inf"}, "-weight: expects a number"},
+      {{"-weight", "1e30"}, "-weight: must be <= 1e6"},
+      {{"--vote", "x"}, "--vote: must be plain or weighted"},
+      {{"-output"}, "-output: is missing its value"},
+      {{"--bogus"}, "--bogus: unknown option"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    EXPECT_EQ(error_of(args).rfind(c.starts, 0), 0u) << c.starts << " vs " << error_of(args);
+  }
+  EXPECT_EQ(error_of({"-guide", "a.png", "b.png"}).rfind("-style: is required", 0), 0u);
+  EXPECT_EQ(error_of({"-style", "s.png"}).rfind("-guide: at least one", 0), 0u);
+}
+
+TEST(SynthArgs, EchoedValuesAreCapped) {
+  const std::string huge(1 << 20, 'x');
+  const std::string e = error_of({"-style", "s.png", "-guide", "a", "b", "-patchsize", huge});
+  EXPECT_LT(e.size(), 200u) << e.size();
+  EXPECT_LT(error_of({huge}).size(), 200u);
+}
+
+TEST(SynthArgs, TooManyGuides) {
+  std::vector<std::string> args{"-style", "s.png"};
+  for (int i = 0; i <= kMaxGuides; ++i) args.insert(args.end(), {"-guide", "a.png", "b.png"});
+  EXPECT_EQ(error_of(args).rfind("-guide: at most", 0), 0u);
+}
+
+io::AnyImage rgb(int w, int h, bool gray) {
+  Image<uint8_t> im(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) im(x, y, c) = uint8_t(gray ? x * 9 + y : x * 9 + y + c * 40);
+  io::AnyImage a;
+  a.image = std::move(im);
+  return a;
+}
+
+TEST(SynthArgs, EqualChannelRgbCountsAsOne) {
+  EXPECT_EQ(effective_channels(rgb(5, 4, true)), 1);
+  EXPECT_EQ(effective_channels(rgb(5, 4, false)), 3);
+}
+
+TEST(SynthArgs, GrayIsSpreadOverRgb) {
+  io::AnyImage g = with_channels(rgb(5, 4, true), 1);
+  ASSERT_EQ(g.channels(), 1);
+  const io::AnyImage back = with_channels(std::move(g), 3);
+  ASSERT_EQ(back.channels(), 3);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(back.value(2, 3, c), back.value(2, 3, 0));
+}
+
+}  // namespace
+}  // namespace emaki::app
