@@ -30,19 +30,19 @@
 namespace emaki::test {
 
 struct CliResult {
-  int exit_code = -1;    // exit status, or -1 when killed by a signal
-  int signal = 0;        // the signal that ended it, 0 when it exited
+  int exit_code = -1;  // exit status, or -1 when killed by a signal
+  int signal = 0;      // the signal that ended it, 0 when it exited
   bool timed_out = false;
   double seconds = 0;
-  std::string err;       // stderr
-  std::string out;       // stdout
+  std::string err;  // stderr
+  std::string out;  // stdout
 };
 
 struct CliOptions {
-  std::filesystem::path cwd;                          // empty: the test's own
-  int64_t address_space_bytes = int64_t(2) << 30;     // RLIMIT_AS; not set under sanitizers
+  std::filesystem::path cwd;                       // empty: the test's own
+  int64_t address_space_bytes = int64_t(2) << 30;  // RLIMIT_AS; not set under sanitizers
   int timeout_seconds = 60;
-  std::vector<std::string> env;                       // extra NAME=VALUE entries
+  std::vector<std::string> env;  // extra NAME=VALUE entries
 };
 
 inline std::string slurp_file(const std::filesystem::path& p) {

@@ -18,8 +18,8 @@ struct SynthGuideArg {
 struct SynthArgs {
   bool help = false;
   std::string style_path, output = "output.png", mask_path, nnf_out, error_out;
-  std::string depth;            // "", "8", "16" or "float"
-  float style_weight = -1.0f;   // -1: EbSynth's default (1)
+  std::string depth;           // "", "8", "16" or "float"
+  float style_weight = -1.0f;  // -1: EbSynth's default (1)
   std::vector<SynthGuideArg> guides;
   synth::Params params;
   int threads = 0;

@@ -20,10 +20,10 @@ std::string error_of(const std::vector<std::string>& args) {
 }
 
 TEST(SynthArgs, EbSynthCommandLine) {
-  const SynthArgs a = parse_synth_args({"-style", "s.png", "-weight", "2", "-guide", "a.png",
-                                        "b.png", "-weight", "0.5", "-guide", "c.png", "d.png",
-                                        "-output", "o.png", "-patchsize", "7", "-uniformity",
-                                        "1000", "-extrapass3x3"});
+  const SynthArgs a =
+      parse_synth_args({"-style", "s.png", "-weight", "2", "-guide", "a.png", "b.png", "-weight",
+                        "0.5", "-guide", "c.png", "d.png", "-output", "o.png", "-patchsize", "7",
+                        "-uniformity", "1000", "-extrapass3x3"});
   EXPECT_EQ(a.style_path, "s.png");
   EXPECT_EQ(a.style_weight, 2.0f);
   ASSERT_EQ(a.guides.size(), 2u);

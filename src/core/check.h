@@ -17,11 +17,12 @@ template <typename A, typename B>
 }
 }  // namespace emaki::detail
 
-#define EMAKI_CHECK_OP(a, b, op)                                                  \
-  do {                                                                            \
-    const auto& va_ = (a);                                                        \
-    const auto& vb_ = (b);                                                        \
-    if (!(va_ op vb_)) ::emaki::detail::check_failed(__FILE__, __LINE__, #a " " #op " " #b, va_, vb_); \
+#define EMAKI_CHECK_OP(a, b, op)                                                      \
+  do {                                                                                \
+    const auto& va_ = (a);                                                            \
+    const auto& vb_ = (b);                                                            \
+    if (!(va_ op vb_))                                                                \
+      ::emaki::detail::check_failed(__FILE__, __LINE__, #a " " #op " " #b, va_, vb_); \
   } while (0)
 #define CHECK(x) EMAKI_CHECK_OP(bool(x), true, ==)
 #define CHECK_EQ(a, b) EMAKI_CHECK_OP(a, b, ==)

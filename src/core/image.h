@@ -31,9 +31,7 @@ struct ImageView {
   T* at(int x, int y) const { return data + y * stride + std::ptrdiff_t(x) * channels; }
   T& operator()(int x, int y, int c = 0) const { return at(x, y)[c]; }
   bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
-  operator ImageView<const T>() const
-    requires(!std::is_const_v<T>)
-  {
+  operator ImageView<const T>() const requires(!std::is_const_v<T>) {
     return {data, width, height, channels, stride};
   }
 };
@@ -97,7 +95,8 @@ class Image {
   ImageView<const T> cview() const { return view(); }
 
   void fill(T v) {
-    for (int y = 0; y < height_; ++y) std::fill(row(y), row(y) + std::size_t(width_) * channels_, v);
+    for (int y = 0; y < height_; ++y)
+      std::fill(row(y), row(y) + std::size_t(width_) * channels_, v);
   }
 
  private:

@@ -36,8 +36,10 @@ Image<T> downsample_impl(ImageView<const T> in) {
           const float v = (tmp(x, ys[0], k) + 3.0f * tmp(x, ys[1], k) + 3.0f * tmp(x, ys[2], k) +
                            tmp(x, ys[3], k)) *
                           0.125f;
-          if constexpr (std::is_integral_v<T>) out(x, y, k) = T(std::lround(v));
-          else out(x, y, k) = v;
+          if constexpr (std::is_integral_v<T>)
+            out(x, y, k) = T(std::lround(v));
+          else
+            out(x, y, k) = v;
         }
     }
   });
@@ -46,8 +48,12 @@ Image<T> downsample_impl(ImageView<const T> in) {
 
 }  // namespace
 
-Image<float> downsample(ImageView<const float> in) { return downsample_impl(in); }
-Image<int16_t> downsample(ImageView<const int16_t> in) { return downsample_impl(in); }
+Image<float> downsample(ImageView<const float> in) {
+  return downsample_impl(in);
+}
+Image<int16_t> downsample(ImageView<const int16_t> in) {
+  return downsample_impl(in);
+}
 
 Image<uint8_t> downsample_mask(ImageView<const uint8_t> in) {
   const int ow = half_size(in.width), oh = half_size(in.height);

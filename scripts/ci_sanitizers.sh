@@ -1,0 +1,21 @@
+#!/bin/sh
+# CI's second half, after ./run_tests.sh: the whole suite under ASan+UBSan and under TSan
+# (halt_on_error: any report fails), and every libFuzzer target for a fixed number of runs over
+# its corpus and the reproducers in tests/data/hostile/ (clang-14, ASan+UBSan+libFuzzer).
+# Each stage prints its wall time.
+set -e
+cd "$(dirname "$0")/.."
+stage() {
+  name=$1; shift
+  t0=$(date +%s)
+  echo "== $name"
+  "$@"
+  echo "== $name: $(( $(date +%s) - t0 )) s"
+}
+j=$(nproc)
+stage "asan build" sh -c "cmake --preset asan >/dev/null && cmake --build --preset asan -j$j >/dev/null"
+stage "asan tests" ctest --preset asan -j"$j"
+stage "tsan build" sh -c "cmake --preset tsan >/dev/null && cmake --build --preset tsan -j$j >/dev/null"
+stage "tsan tests" ctest --preset tsan -j"$j"
+stage "fuzz build" sh -c "cmake --preset fuzz >/dev/null && cmake --build --preset fuzz -j$j >/dev/null"
+stage "fuzz smoke" ctest --preset fuzz -j"$j"
