@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "core/error.h"
 #include "render/passes.h"
@@ -11,7 +12,7 @@
 namespace emaki::exemplar {
 
 namespace {
-constexpr float kPi = 3.14159265358979f;
+constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kDeg = kPi / 180.0f;
 }  // namespace
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "render/passes.h"
 #include "render/renderer.h"
@@ -11,7 +12,7 @@
 namespace emaki::exemplar {
 namespace {
 
-constexpr double kPi = 3.14159265358979;
+constexpr double kPi = std::numbers::pi;
 
 struct Rendered {
   Image<float> frame;

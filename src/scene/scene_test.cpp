@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <numbers>
 #include <string>
 
 #include "io/gltf_loader.h"
@@ -13,7 +14,7 @@ namespace emaki::scene {
 namespace {
 
 const std::string kScenes = std::string(EMAKI_TEST_DATA) + "/scenes/";
-constexpr float kPi = 3.14159265358979f;
+constexpr float kPi = std::numbers::pi_v<float>;
 
 void expect_near(const glm::vec3& a, const glm::vec3& b, float tol = 1e-4f) {
   EXPECT_NEAR(a.x, b.x, tol);

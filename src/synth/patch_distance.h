@@ -1,5 +1,6 @@
 // Patch distance: the sum of squared differences between two patches of int16 feature pixels,
-// computed exactly in 64-bit integers (weights are folded into the data, see features.h).
+// computed exactly in 64-bit integers (weights are folded into the data by
+// ChannelMap in pyramid.h).
 // A plain scalar version, an AVX2 version tested against it, and a dispatcher that picks one.
 #pragma once
 

@@ -1,0 +1,233 @@
+// Whole synthesis on small synthetic images: identity, schedule, determinism, masks, precision,
+// validation.
+#include "synth/synthesizer.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "synth/test_images.h"
+
+namespace emaki::synth {
+namespace {
+
+using namespace test;
+
+struct Fixture {
+  Image<float> style, guide_src, guide_tgt;
+  Inputs inputs() const {
+    Inputs in;
+    in.style = style.cview();
+    in.guides.push_back({"guide", guide_src.cview(), guide_tgt.cview(), -1.0f});
+    return in;
+  }
+};
+
+TEST(Synthesize, IdentityReproducesExemplarWithZeroError) {
+  Fixture f;
+  f.style = textured(64, 48, 1);
+  f.guide_src = textured(64, 48, 2);
+  f.guide_tgt = f.guide_src.clone();
+  Params params;
+  params.seed = 5;
+  // EbSynth's iteration counts: emaki's leaner default schedule leaves a few pixels of this
+  // tiny, 3-level image one search short of the exact answer.
+  params.search_vote_iters = 6;
+  params.patch_match_iters = 4;
+  OutputRequest req;
+  req.error = true;
+  req.nnf = true;
+  const Result res = synthesize(f.inputs(), params, req);
+  // Away from the border: target pixels within r of the edge all map to the source's edge
+  // patches (clamped), which crowds their occupancy and pushes neighbours up to 2r further in
+  // to other, equally perfect-looking but not identical, matches.
+  const int b = 2 * params.patch_size;
+  int wrong = 0;
+  for (int y = b; y < 48 - b; ++y)
+    for (int x = b; x < 64 - b; ++x) {
+      wrong += res.nnf(x, y, 0) != x || res.nnf(x, y, 1) != y || res.error(x, y) != 0.0f;
+      for (int c = 0; c < 3; ++c) wrong += std::abs(res.image(x, y, c) - f.style(x, y, c)) > 1e-6f;
+    }
+  EXPECT_EQ(wrong, 0);
+}
+
+// The finest level's search-vote count can be lowered alone (temporal frames use 1).
+TEST(Schedule, FinestSearchVoteItersOverridesOnlyTheFinestLevel) {
+  Params p;
+  const std::vector<LevelSchedule> base = make_schedule(p, 6);
+  p.finest_search_vote_iters = 1;
+  const std::vector<LevelSchedule> lean = make_schedule(p, 6);
+  ASSERT_EQ(base.size(), 6u);
+  ASSERT_EQ(lean.size(), 6u);
+  EXPECT_EQ(base.back().search_vote_iters, 2);
+  EXPECT_EQ(lean.back().search_vote_iters, 1);
+  for (std::size_t l = 0; l + 1 < base.size(); ++l) {
+    EXPECT_EQ(lean[l].search_vote_iters, base[l].search_vote_iters) << l;
+    EXPECT_EQ(lean[l].patch_match_iters, base[l].patch_match_iters) << l;
+    EXPECT_EQ(lean[l].max_search_radius, base[l].max_search_radius) << l;
+  }
+}
+
+// The identity start, one level, no search: the field is the identity, clamped to the source's
+// patch centres, and scaled when the target is larger.
+TEST(Synthesize, IdentityFieldInit) {
+  Fixture f;
+  f.style = noise(40, 30, 1, 4);
+  f.guide_src = textured(40, 30, 5);
+  f.guide_tgt = textured(80, 60, 6);
+  Params params;
+  params.init = FieldInit::kIdentity;
+  params.pyramid_levels = 1;
+  params.search_vote_iters = 0;
+  OutputRequest req;
+  req.nnf = true;
+  const Result res = synthesize(f.inputs(), params, req);
+  const int r = params.patch_size / 2;
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 80; ++x) {
+      ASSERT_EQ(res.nnf(x, y, 0), std::clamp(x / 2, r, 39 - r)) << x << "," << y;
+      ASSERT_EQ(res.nnf(x, y, 1), std::clamp(y / 2, r, 29 - r)) << x << "," << y;
+    }
+  // With search, a random start would have to find the same field; the identity start keeps it.
+  params.search_vote_iters = 1;
+  params.patch_match_iters = 1;
+  params.search_radius = 2;
+  f.guide_tgt = f.guide_src.clone();
+  const Result same = synthesize(f.inputs(), params, req);
+  int moved = 0;
+  for (int y = 2 * r; y < 30 - 2 * r; ++y)
+    for (int x = 2 * r; x < 40 - 2 * r; ++x)
+      moved += same.nnf(x, y, 0) != x || same.nnf(x, y, 1) != y;
+  EXPECT_EQ(moved, 0);
+}
+
+TEST(Synthesize, BitIdenticalForAnyThreadCountAndRun) {
+  Fixture f;
+  f.style = noise(96, 80, 3, 4);
+  f.guide_src = textured(96, 80, 5);
+  f.guide_tgt = textured(120, 72, 6);
+  Params params;
+  OutputRequest req;
+  req.nnf = true;
+  std::vector<Result> results;
+  for (int threads : {1, 2, 3, 2}) {
+    set_thread_count(threads);
+    results.push_back(synthesize(f.inputs(), params, req));
+  }
+  set_thread_count(0);
+  for (std::size_t i = 1; i < results.size(); ++i) {
+    EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
+    for (int y = 0; y < 72; ++y)
+      ASSERT_EQ(0, std::memcmp(results[0].nnf.row(y), results[i].nnf.row(y), 120 * 2 * 4));
+  }
+}
+
+TEST(Synthesize, SeedChangesTheResult) {
+  Fixture f;
+  f.style = noise(64, 48, 1, 4);
+  f.guide_src = textured(64, 48, 5);
+  f.guide_tgt = textured(64, 48, 6);
+  Params a, b;
+  b.seed = 99;
+  EXPECT_FALSE(same_bits(synthesize(f.inputs(), a).image, synthesize(f.inputs(), b).image));
+}
+
+TEST(Synthesize, MaskLeavesOutsideTransparent) {
+  Fixture f;
+  f.style = noise(48, 40, 1, 8);
+  f.guide_src = textured(48, 40, 9);
+  f.guide_tgt = textured(48, 40, 10);
+  Image<float> mask(48, 40, 1);
+  for (int y = 10; y < 30; ++y)
+    for (int x = 12; x < 36; ++x) mask(x, y) = 1.0f;
+  Inputs in = f.inputs();
+  in.target_mask = Plane(mask.cview());
+  OutputRequest req;
+  req.nnf = true;
+  const Result res = synthesize(in, Params(), req);
+  ASSERT_EQ(res.image.channels(), 2);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const bool inside = mask(x, y) > 0.0f;
+      EXPECT_EQ(res.image(x, y, 1), inside ? 1.0f : 0.0f);
+      if (!inside) {
+        EXPECT_EQ(res.image(x, y, 0), 0.0f);
+      }
+      const bool far = x < 8 || x > 39 || y < 6 || y > 33;  // beyond the dilated mask
+      if (far) {
+        EXPECT_EQ(res.nnf(x, y, 0), -1);
+      }
+    }
+}
+
+TEST(Synthesize, FloatGuidesKeepThousandthSteps) {
+  // Position-like guide with 0.001 steps: the target is the source shifted by 7 pixels. With
+  // 8-bit guides (1/255 steps) neighbours would tie; with emaki's quantisation the field must
+  // find the exact shift.
+  const int w = 160, h = 120, shift = 7;
+  Image<float> src(w, h, 2), tgt(w - shift, h, 2);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      src(x, y, 0) = 0.3f + 0.001f * float(x);
+      src(x, y, 1) = 0.2f + 0.001f * float(y);
+      if (x < w - shift) {
+        tgt(x, y, 0) = 0.3f + 0.001f * float(x + shift);
+        tgt(x, y, 1) = 0.2f + 0.001f * float(y);
+      }
+    }
+  Image<float> style(w, h, 1);  // flat: only the guide decides
+  Inputs in;
+  in.style = style.cview();
+  in.guides.push_back({"position", src.cview(), tgt.cview(), 1.0f});
+  Params params;
+  params.uniformity = 0.0f;
+  OutputRequest req;
+  req.nnf = true;
+  const Result res = synthesize(in, params, req);
+  int exact = 0, total = 0;
+  for (int y = 4; y < h - 4; ++y)
+    for (int x = 4; x < w - shift - 4; ++x) {
+      ++total;
+      exact += res.nnf(x, y, 0) == x + shift && res.nnf(x, y, 1) == y;
+    }
+  EXPECT_GT(double(exact) / total, 0.99);
+}
+
+TEST(Validate, RejectsBadInputsNamingThem) {
+  Fixture f;
+  f.style = noise(32, 32, 3, 1);
+  f.guide_src = noise(32, 32, 1, 2);
+  f.guide_tgt = noise(40, 30, 1, 3);
+  Params p;
+  p.patch_size = 4;
+  EXPECT_THROW(validate(f.inputs(), p), Error);
+  p.patch_size = 5;
+  EXPECT_NO_THROW(validate(f.inputs(), p));
+  Image<float> wrong(31, 32, 1);
+  Inputs in = f.inputs();
+  in.guides[0].source = wrong.cview();
+  try {
+    validate(in, p);
+    FAIL() << "size mismatch accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.subject(), "guide");
+  }
+  Image<float> nan = noise(32, 32, 1, 4);
+  nan(3, 4) = std::numeric_limits<float>::quiet_NaN();
+  in = f.inputs();
+  in.guides[0].source = nan.cview();
+  EXPECT_THROW(validate(in, p), Error);
+  Image<float> tiny(4, 4, 1);
+  in = f.inputs();
+  in.guides[0].target = tiny.cview();
+  EXPECT_THROW(validate(in, p), Error);
+}
+
+}  // namespace
+}  // namespace emaki::synth
