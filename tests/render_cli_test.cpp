@@ -10,6 +10,7 @@
 #include <string>
 
 #include "io/image_io.h"
+#include "tests/cli_run.h"
 
 namespace {
 
@@ -22,16 +23,10 @@ struct Outcome {
   std::string output;  // stderr (and stdout)
 };
 
+// args start with the subcommand; stderr and stdout together, as a user sees them.
 Outcome run(const std::string& args) {
-  const std::string cmd = kEmaki + " " + args + " 2>&1";  // args start with the subcommand
-  Outcome r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
-  const int status = pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  const emaki::test::CliResult r = emaki::test::run_cli(kEmaki, emaki::test::split_args(args));
+  return {r.exit_code, r.err + r.out};
 }
 
 class RenderCli : public ::testing::Test {

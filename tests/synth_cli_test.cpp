@@ -14,6 +14,7 @@
 
 #include "core/rng.h"
 #include "io/image_io.h"
+#include "tests/cli_run.h"
 
 namespace fs = std::filesystem;
 using namespace emaki;
@@ -26,23 +27,13 @@ struct RunResult {
 };
 
 RunResult run(const std::string& args) {
-  const fs::path err_file =
-      fs::temp_directory_path() / ("emaki_cli_err_" + std::to_string(::getpid()));
-  const std::string cmd =
-      std::string(EMAKI_BINARY) + " synth " + args + " 2>" + err_file.string() + " >/dev/null";
-  const int status = std::system(cmd.c_str());
-  std::ifstream f(err_file);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  fs::remove(err_file);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+  std::vector<std::string> argv = test::split_args(args);
+  argv.insert(argv.begin(), "synth");
+  const test::CliResult r = test::run_cli(EMAKI_BINARY, argv);
+  return {r.exit_code, r.err};
 }
 
-int count_lines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
+using test::count_lines;
 
 class SynthCli : public ::testing::Test {
  protected:
