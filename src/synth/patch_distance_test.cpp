@@ -1,6 +1,5 @@
 // Patch distance kernels: the AVX2 kernel equals the scalar one bit for bit, and sums are exact.
 #include "synth/patch_distance.h"
-#include "synth/pyramid.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include "synth/pyramid.h"
 #include "synth/test_images.h"
 
 namespace emaki::synth {
