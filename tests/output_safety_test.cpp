@@ -53,7 +53,7 @@ exemplar = "sphere"
 
 [outputs]
 folder = "@FOLDER@"
-mp4 = false
+mp4 = @MP4@
 contact_sheet = @SHEET@
 )";
 
@@ -61,6 +61,7 @@ struct ShotText {
   int last = 1, w = 32, h = 24;
   std::string base_extra, folder = "out";
   bool sheet = false;
+  bool mp4 = false;
 };
 
 std::string slurp(const fs::path& p) {
@@ -109,6 +110,7 @@ class OutputSafety : public ::testing::Test {
     put("@BASE_EXTRA@", t.base_extra);
     put("@FOLDER@", t.folder);
     put("@SHEET@", t.sheet ? "true" : "false");
+    put("@MP4@", t.mp4 ? "true" : "false");
     std::ofstream(p(name)) << s;
   }
 
@@ -238,6 +240,25 @@ TEST_F(OutputSafety, PlantedSymlinksAreNeverWrittenThrough) {
   EXPECT_TRUE(slurp(dir_ / "victim2.txt") == "also precious\n");
   EXPECT_FALSE(fs::is_symlink(dir_ / "out/composite/frame_0005.png"));
   EXPECT_TRUE(fs::is_regular_file(dir_ / "out/composite/frame_0005.png"));
+}
+
+TEST_F(OutputSafety, PreviewsReplaceALinkAtTheirNameAndLeaveNoTemporary) {
+  if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) GTEST_SKIP() << "no ffmpeg on PATH";
+  ShotText t;
+  t.sheet = true;
+  t.mp4 = true;
+  write_shot(t);
+  fs::create_directories(dir_ / "out");
+  write_text(dir_ / "victim.txt", "precious\n");
+  fs::create_symlink(dir_ / "victim.txt", dir_ / "out/preview.mp4");
+  fs::create_symlink(dir_ / "victim.txt", dir_ / "out/contact_sheet.png");
+  expect_ok(emaki("run " + p("shot.toml")));
+  EXPECT_TRUE(slurp(dir_ / "victim.txt") == "precious\n");
+  EXPECT_FALSE(fs::is_symlink(dir_ / "out/preview.mp4"));
+  EXPECT_GT(fs::file_size(dir_ / "out/preview.mp4"), 0u);
+  EXPECT_FALSE(fs::is_symlink(dir_ / "out/contact_sheet.png"));
+  for (const auto& e : fs::recursive_directory_iterator(dir_ / "out"))
+    EXPECT_EQ(e.path().filename().string().find(".emaki-tmp-"), std::string::npos) << e.path();
 }
 
 // ---- the output-folder lock ----
