@@ -101,7 +101,9 @@ int run_run(const Args& args) {
   app.add_option("shot", shot_path, "the shot file (TOML; see docs/shot_file.md)")->required();
   app.add_option("--frames", frames, "FIRST-LAST or FRAME: only these frames (default: all)");
   app.add_option("--layers", layers, "comma-separated layer names (default: all)");
-  app.add_flag("--force", force, "synthesize again frames that are already finished");
+  app.add_flag("--force", force,
+               "synthesize again frames that are already finished (outputs made with other "
+               "settings are always redone)");
   app.add_flag("--no-previews", no_previews, "do not write the contact sheet and the MP4");
   app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores (default: the shot's)")
       ->check(CLI::NonNegativeNumber);
@@ -154,7 +156,8 @@ int run_composite(const Args& args) {
   options.progress = progress_printer("composite");
   const auto source = io::open_frames(shot);
   const pipeline::CompositeInputs ci = io::load_composite_inputs(shot);
-  io::FileStore store(shot);
+  // Layers made with other settings are an error here: re-colouring never synthesizes.
+  io::FileStore store(shot, io::StoreMode::kReadFinished);
   const int n = pipeline::recomposite(shot, *source, ci, store, options);
   end_progress_line();
   if (!no_previews) io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
@@ -189,8 +192,7 @@ int run_qa(const Args& args) {
   const int b = o.last_frame < 0 ? shot.source.last_frame : o.last_frame;
   if (b <= a) throw Error("--frames", "needs at least two frames");
   const auto source = io::open_frames(shot);
-  const io::OutputPaths paths{shot.outputs.folder};
-  io::FileStore store(shot);
+  io::FileStore store(shot, io::StoreMode::kReadFinished);
   for (int f = a; f <= b; ++f)
     if (!store.has_layer(*l, f))
       throw Error(fmt::format("layers.{}", layer),

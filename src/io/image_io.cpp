@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "io/oiio_backend.h"
+#include "io/output_store.h"
 #include "io/png_io.h"
 
 namespace emaki::io {
@@ -266,29 +267,25 @@ void write_image(const std::string& path, ImageView<const float> image,
     image = clamped.cview();
   }
 
-  const fs::path target(path);
-  const fs::path tmp =
-      target.parent_path() / fmt::format(".{}.tmp{}{}", target.stem().string(), ::getpid(), ext);
-  std::error_code ec;
-  try {
-    if (ext == ".png") {
-      detail::write_png(tmp.string(), image, type == 1, path);
-    } else {
-      std::lock_guard lock(detail::oiio_mutex());
-      if (std::string e =
-              detail::oiio_backend(path).write(tmp.string(), image, options.channel_names, type);
-          !e.empty())
-        throw Error(path, e);
+  // The temporary is created exclusively with an unpredictable name, so a file or symlink
+  // planted beside the target is never written through.
+  TempFile tmp(path, path);
+  if (ext == ".png") {
+    const int fd = tmp.release_fd();
+    std::FILE* file = ::fdopen(fd, "wb");
+    if (!file) {
+      ::close(fd);
+      throw Error(path, "cannot open for writing");
     }
-  } catch (...) {
-    fs::remove(tmp, ec);
-    throw;
+    detail::write_png(file, image, type == 1, path);
+  } else {
+    std::lock_guard lock(detail::oiio_mutex());
+    if (std::string e =
+            detail::oiio_backend(path).write(tmp.path(), image, options.channel_names, type);
+        !e.empty())
+      throw Error(path, e);
   }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error(path, "cannot move the finished file into place");
-  }
+  tmp.commit();
 }
 
 }  // namespace emaki::io

@@ -84,9 +84,15 @@ AnyImage read_png(const std::string& path) {
 
 void write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
                const std::string& subject) {
-  if (image.channels < 1 || image.channels > 4) throw Error(subject, "PNG takes 1 to 4 channels");
-  std::unique_ptr<FILE, FileCloser> file(std::fopen(path.c_str(), "wb"));
+  std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) throw Error(subject, "cannot open for writing");
+  write_png(file, image, sixteen_bit, subject);
+}
+
+void write_png(std::FILE* opened, ImageView<const float> image, bool sixteen_bit,
+               const std::string& subject) {
+  std::unique_ptr<FILE, FileCloser> file(opened);
+  if (image.channels < 1 || image.channels > 4) throw Error(subject, "PNG takes 1 to 4 channels");
   const int w = image.width, h = image.height, nc = image.channels;
   const int bytes = sixteen_bit ? 2 : 1;
   std::vector<unsigned char> buf(std::size_t(w) * h * nc * bytes);

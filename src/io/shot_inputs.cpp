@@ -9,10 +9,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 
 #include "core/error.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
+#include "io/shot_manifest.h"
 #include "io/studio_passes.h"
 
 extern char** environ;
@@ -261,15 +263,42 @@ void make_folder(const fs::path& p) {
     throw Error("outputs.folder", fmt::format("cannot create folder '{}'", p.string()));
 }
 
-// image_io writes ".<stem>.tmp<pid><ext>" and renames it; a killed run leaves those behind.
-void remove_temporaries(const fs::path& dir) {
+constexpr const char* kManifest = ".emaki-manifest";
+
+bool has_ext(const std::string& name, std::size_t from, std::initializer_list<const char*> exts) {
+  for (const char* e : exts)
+    if (name.compare(from, std::string::npos, e) == 0) return true;
+  return false;
+}
+
+// "<prefix><digits><.png|.exr>": the frame files emaki writes (prefix "base_" or "frame_").
+bool is_frame_name(const std::string& name, const std::string& prefix,
+                   std::initializer_list<const char*> exts) {
+  if (name.compare(0, prefix.size(), prefix) != 0) return false;
+  std::size_t i = prefix.size();
+  const std::size_t digits = i;
+  while (i < name.size() && std::isdigit(static_cast<unsigned char>(name[i]))) ++i;
+  return i > digits && has_ext(name, i, exts);
+}
+
+// Removes the frame files emaki wrote in `dir` (never anything else: a user's own file there
+// survives).
+void remove_frames(const fs::path& dir, const std::string& prefix,
+                   std::initializer_list<const char*> exts) {
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() > 1 && name[0] == '.' && name.find(".tmp") != std::string::npos &&
-        entry.is_regular_file(ec))
-      fs::remove(entry.path(), ec);
-  }
+  std::vector<fs::path> doomed;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (is_frame_name(entry.path().filename().string(), prefix, exts) && !entry.is_directory(ec))
+      doomed.push_back(entry.path());
+  for (const fs::path& p : doomed) fs::remove(p, ec);
+}
+
+bool any_frame(const fs::path& dir, const std::string& prefix,
+               std::initializer_list<const char*> exts) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (is_frame_name(entry.path().filename().string(), prefix, exts)) return true;
+  return false;
 }
 
 std::vector<std::string> value_names(const std::string& prefix, int channels, int value_channels) {
@@ -282,30 +311,95 @@ std::vector<std::string> value_names(const std::string& prefix, int channels, in
   return n;
 }
 
+const char* kRedo = "run `emaki run` to redo it (`emaki run --force` redoes everything)";
+
 }  // namespace
 
-FileStore::FileStore(const Shot& shot) : shot_(shot) {
+FileStore::FileStore(const Shot& shot, StoreMode mode) : shot_(shot), mode_(mode) {
   paths_.folder = shot.outputs.folder;
   const fs::path root(paths_.folder);
-  std::vector<fs::path> dirs = {root, root / "composite", root / "layered"};
-  for (const pipeline::Layer& l : shot.layers) dirs.push_back(root / "layers" / l.name);
-  for (const fs::path& d : dirs) {
-    make_folder(d);
-    remove_temporaries(d);
+  make_folder(root);
+  // Before anything is cleaned up or written: another emaki's temporaries are not ours to remove.
+  lock_ = std::make_unique<FolderLock>(paths_.folder);
+  remove_temporaries(root.string(), [](const std::string& t) {
+    return t == "contact_sheet.png" || t == "preview.mp4";
+  });
+  for (const char* sub : {"composite", "layered"}) {
+    make_folder(root / sub);
+    remove_temporaries((root / sub).string(), [](const std::string& t) {
+      return t == kManifest || is_frame_name(t, "frame_", {".png", ".exr"});
+    });
   }
+  for (const pipeline::Layer& l : shot.layers) {
+    const fs::path dir = root / "layers" / l.name;
+    make_folder(dir);
+    remove_temporaries(dir.string(), [&](const std::string& t) {
+      return t == kManifest || is_frame_name(t, l.name + "_", {".png", ".exr"});
+    });
+    Manifested& m = layers_[l.name];
+    m.want = layer_manifest(shot, l);
+    const auto have = read_manifest((dir / kManifest).string());
+    m.current = have && *have == m.want;
+    if (!m.current)
+      m.stale = have ? manifest_difference(*have, m.want)
+                : any_frame(dir, l.name + "_", {".png", ".exr"})
+                    ? "no record of the settings that made it"
+                    : "";
+  }
+  frames_.want = frames_manifest(shot);
+  const auto have = read_manifest((root / "composite" / kManifest).string());
+  frames_.current = have && *have == frames_.want;
+}
+
+FileStore::~FileStore() = default;
+
+const FileStore::Manifested& FileStore::layer_state(const pipeline::Layer& layer) const {
+  const auto it = layers_.find(layer.name);
+  CHECK(it != layers_.end());
+  return it->second;
 }
 
 bool FileStore::has_layer(const pipeline::Layer& layer, int frame) const {
+  const Manifested& m = layer_state(layer);
+  if (!m.current) {
+    // `emaki run` redoes a stale layer; commands that only read finished layers stop.
+    if (mode_ == StoreMode::kReadFinished && !m.stale.empty())
+      throw Error((fs::path(paths_.folder) / "layers" / layer.name).string(),
+                  fmt::format("was made with other settings ({}); {}", m.stale, kRedo));
+    return false;
+  }
   std::error_code ec;
   if (!fs::is_regular_file(paths_.layer_exr(layer.name, frame), ec)) return false;
   return !shot_.outputs.layer_png || fs::is_regular_file(paths_.layer_png(layer.name, frame), ec);
 }
 
 Image<float> FileStore::read_layer(const pipeline::Layer& layer, int frame) const {
-  return read_image_float(paths_.layer_exr(layer.name, frame));
+  const std::string path = paths_.layer_exr(layer.name, frame);
+  Image<float> img = read_image_float(path);
+  // The file is on disk, where anything may have replaced it: what the chain and the composite
+  // index must match the shot.
+  const int n = layer.single_colour ? 1 : 3;
+  const int w = shot_.source.width, h = shot_.source.height;
+  if (img.width() != w || img.height() != h || img.channels() < n || img.channels() > n + 1)
+    throw Error(path,
+                fmt::format("is {}x{} with {} channels, the shot makes {}x{} with {} or {}; {}",
+                            img.width(), img.height(), img.channels(), w, h, n, n + 1, kRedo));
+  return img;
 }
 
 void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) {
+  Manifested& m = layers_.at(layer.name);
+  if (!m.current) {
+    // Made with other settings: its old frames go before the new settings are recorded, so a
+    // run killed in between leaves no old frame under a new manifest.
+    const fs::path dir = fs::path(paths_.folder) / "layers" / layer.name;
+    std::error_code ec;
+    fs::remove(dir / kManifest, ec);
+    remove_frames(dir, layer.name + "_", {".png", ".exr"});
+    write_manifest((dir / kManifest).string(), m.want);
+    m.current = true;
+    m.stale.clear();
+  }
   const int n = layer.single_colour ? 1 : 3;
   // The PNG first: the EXR is what marks the frame finished, so it is written last.
   if (shot_.outputs.layer_png) {
@@ -320,6 +414,7 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
 }
 
 bool FileStore::has_frame(int frame) const {
+  if (!frames_.current) return false;
   std::error_code ec;
   const pipeline::Outputs& o = shot_.outputs;
   if (o.composite_png && !fs::is_regular_file(paths_.composite_png(frame), ec)) return false;
@@ -332,6 +427,15 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
                             const std::vector<ImageView<const float>>& layers,
                             ImageView<const float> passes) {
   const pipeline::Outputs& o = shot_.outputs;
+  if (!frames_.current) {
+    const fs::path root(paths_.folder);
+    std::error_code ec;
+    fs::remove(root / "composite" / kManifest, ec);
+    remove_frames(root / "composite", "frame_", {".png", ".exr"});
+    remove_frames(root / "layered", "frame_", {".exr"});
+    write_manifest((root / "composite" / kManifest).string(), frames_.want);
+    frames_.current = true;
+  }
   // The composite without its (constant) alpha.
   Image<float> rgb(composite.width, composite.height, 3);
   for (int y = 0; y < composite.height; ++y)
@@ -378,10 +482,10 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
 // ---- previews ----
 
 void encode_mp4(const std::string& pattern, int first, float fps, int crf, const std::string& out) {
-  const fs::path target(out);
-  const std::string tmp =
-      (target.parent_path() / fmt::format(".{}.tmp{}.mp4", target.stem().string(), ::getpid()))
-          .string();
+  // Created exclusively beside the target; ffmpeg then writes the file we made (commit checks
+  // that it still is).
+  TempFile tmp_file(out, "outputs.mp4");
+  const std::string tmp = tmp_file.path();
   std::vector<std::string> args = {"ffmpeg", "-nostdin", "-y", "-loglevel", "error", "-framerate",
                                    fmt::format("{}", fps), "-start_number", std::to_string(first),
                                    "-i", pattern, "-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf",
@@ -396,19 +500,19 @@ void encode_mp4(const std::string& pattern, int first, float fps, int crf, const
     throw Error("outputs.mp4", "cannot run 'ffmpeg' (is it installed and on PATH?)");
   int status = 0;
   waitpid(pid, &status, 0);
-  std::error_code ec;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    fs::remove(tmp, ec);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw Error("outputs.mp4", fmt::format("ffmpeg failed encoding '{}'", pattern));
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) throw Error(out, "cannot move the encoded MP4 into place: " + ec.message());
+  tmp_file.commit();
 }
 
 std::vector<std::string> write_previews(const Shot& shot, int first, int last) {
   std::vector<std::string> written;
   const OutputPaths paths{shot.outputs.folder};
   std::error_code ec;
+  // Frames composited under other settings (a killed run after a resize) are not previewed.
+  const auto made =
+      read_manifest((fs::path(shot.outputs.folder) / "composite" / kManifest).string());
+  if (!made || *made != frames_manifest(shot)) return written;
   for (int f = first; f <= last; ++f)
     if (!fs::is_regular_file(paths.composite_png(f), ec)) return written;  // not all composited
   if (shot.outputs.contact_sheet && shot.outputs.composite_png) {
@@ -417,7 +521,12 @@ std::vector<std::string> write_previews(const Shot& shot, int first, int last) {
     std::vector<Image<float>> thumbs;
     for (int i = 0; i < count; ++i) {
       const int f = count == 1 ? first : first + int((long(last - first) * i) / (count - 1));
-      thumbs.push_back(read_image_float(paths.composite_png(f)));
+      const std::string file = paths.composite_png(f);
+      thumbs.push_back(read_image_float(file));
+      const Image<float>& t = thumbs.back();
+      if (t.width() != shot.source.width || t.height() != shot.source.height)
+        throw Error(file, fmt::format("is {}x{}, the shot makes {}x{}; {}", t.width(), t.height(),
+                                      shot.source.width, shot.source.height, kRedo));
     }
     const Image<float> sheet = pipeline::contact_sheet(thumbs, 4, 320);
     WriteOptions wo;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "io/output_store.h"
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "pipeline/shot.h"
@@ -50,10 +51,20 @@ struct OutputPaths {
   std::string contact_sheet() const;
 };
 
+enum class StoreMode {
+  kRun,           // layers made with other settings are redone (emaki run)
+  kReadFinished,  // they are an error naming the layer (emaki composite, qa flicker)
+};
+
+// Layer frames and composited frames each carry a manifest of the settings that made them
+// (io/shot_manifest.h). Files made under other settings are never read back: `kRun` deletes
+// and redoes them on the first write, `kReadFinished` throws emaki::Error naming the folder.
 class FileStore : public pipeline::Store {
  public:
-  // Creates the folders and removes temporary files a killed run left behind.
-  explicit FileStore(const pipeline::Shot& shot);
+  // Creates the folders, locks the output folder (emaki::Error naming the holder when another
+  // emaki has it) and removes temporary files a killed run left behind.
+  explicit FileStore(const pipeline::Shot& shot, StoreMode mode = StoreMode::kRun);
+  ~FileStore() override;
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
@@ -64,8 +75,19 @@ class FileStore : public pipeline::Store {
   const OutputPaths& paths() const { return paths_; }
 
  private:
+  struct Manifested {
+    Manifest want;         // the settings of the shot as it is now
+    bool current = false;  // the files on disk were made with them
+    std::string stale;     // !current and something is there: what changed
+  };
+  const Manifested& layer_state(const pipeline::Layer& layer) const;
+
   const pipeline::Shot& shot_;
+  StoreMode mode_;
   OutputPaths paths_;
+  std::unique_ptr<FolderLock> lock_;
+  std::map<std::string, Manifested> layers_;
+  Manifested frames_;
 };
 
 // The contact sheet and the MP4 preview of the composited frames [first, last] (each when the

@@ -318,18 +318,23 @@ Image<float> contact_sheet(const std::vector<Image<float>>& frames, int columns,
   Image<float> sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3);
   sheet.fill(1.0f);
   for (std::size_t i = 0; i < frames.size(); ++i) {
+    // Each thumbnail samples its own frame's size and channels: frames read back from disk need
+    // not all match the first one, and a mismatch must never index past a frame.
     const Image<float>& f = frames[i];
-    CHECK_GE(f.channels(), 3);
+    if (f.empty()) continue;
+    const int sw = f.width(), sh = f.height(), last_channel = f.channels() - 1;
     const int ox = gap + int(i % columns) * (tw + gap), oy = gap + int(i / columns) * (th + gap);
     // Box filter over the source pixels each thumbnail pixel covers.
     for (int y = 0; y < th; ++y)
       for (int x = 0; x < tw; ++x) {
-        const int x0 = x * fw / tw, x1 = std::max(x0 + 1, (x + 1) * fw / tw);
-        const int y0 = y * fh / th, y1 = std::max(y0 + 1, (y + 1) * fh / th);
+        const int x0 = int(int64_t(x) * sw / tw),
+                  x1 = std::max(x0 + 1, int(int64_t(x + 1) * sw / tw));
+        const int y0 = int(int64_t(y) * sh / th),
+                  y1 = std::max(y0 + 1, int(int64_t(y + 1) * sh / th));
         for (int c = 0; c < 3; ++c) {
           double s = 0;
           for (int yy = y0; yy < y1; ++yy)
-            for (int xx = x0; xx < x1; ++xx) s += f(xx, yy, c);
+            for (int xx = x0; xx < x1; ++xx) s += f(xx, yy, std::min(c, last_channel));
           sheet(ox + x, oy + y, c) = float(s / ((x1 - x0) * (y1 - y0)));
         }
       }

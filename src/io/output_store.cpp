@@ -1,0 +1,258 @@
+#include "io/output_store.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/file.h>
+#include <sys/random.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/limits.h"
+
+namespace emaki::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kTempMark = ".emaki-tmp-";
+constexpr std::size_t kTempMarkSize = 11;
+constexpr std::size_t kRandomDigits = 16;
+
+bool is_hex(const std::string& s) {
+  for (char c : s)
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+  return true;
+}
+
+}  // namespace
+
+unsigned long long random_u64() {
+  unsigned long long v = 0;
+  std::size_t got = 0;
+  auto* bytes = reinterpret_cast<unsigned char*>(&v);
+  while (got < sizeof v) {
+    const ssize_t n = ::getrandom(bytes + got, sizeof v - got, 0);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      // No getrandom (very old kernel): time and address entropy still make the name hard to
+      // guess, and O_EXCL keeps a guessed name harmless.
+      v ^= static_cast<unsigned long long>(
+               std::chrono::high_resolution_clock::now().time_since_epoch().count()) ^
+           reinterpret_cast<uintptr_t>(&v) ^ (static_cast<unsigned long long>(::getpid()) << 32);
+      break;
+    }
+    got += std::size_t(n);
+  }
+  return v;
+}
+
+// ---- temporaries ----
+
+TempFile::TempFile(const std::string& target, const std::string& subject)
+    : target_(target), subject_(subject) {
+  const fs::path t(target);
+  const std::string stem = t.stem().string(), ext = t.extension().string();
+  // A few tries: a collision of 64 random bits only happens when someone planted the name.
+  for (int attempt = 0; attempt < 8 && fd_ < 0; ++attempt) {
+    path_ = (t.parent_path() / fmt::format(".{}{}{:016x}{}", stem, kTempMark, random_u64(), ext))
+                .string();
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd_ < 0 && errno != EEXIST)
+      throw Error(subject_, fmt::format("cannot create a temporary file beside it ({})",
+                                        std::strerror(errno)));
+  }
+  if (fd_ < 0) throw Error(subject_, "cannot create a temporary file beside it (names taken)");
+  struct stat st {};
+  ::fstat(fd_, &st);
+  dev_ = st.st_dev;
+  ino_ = st.st_ino;
+}
+
+TempFile::~TempFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_) {
+    // Only our own file: if the name now points elsewhere, leave it for the user to see.
+    struct stat st {};
+    if (::lstat(path_.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == dev_ &&
+        st.st_ino == ino_)
+      ::unlink(path_.c_str());
+  }
+}
+
+int TempFile::release_fd() {
+  const int fd = fd_;
+  fd_ = -1;
+  return fd;
+}
+
+void TempFile::commit() {
+  // Writers that take a path (OpenImageIO, ffmpeg) reopen the name: check it still names the
+  // file we created, not a symlink or file swapped in meanwhile.
+  struct stat st {};
+  if (::lstat(path_.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_dev != dev_ ||
+      st.st_ino != ino_)
+    throw Error(subject_,
+                fmt::format("its temporary file '{}' was replaced while writing", echo(path_)));
+  if (::rename(path_.c_str(), target_.c_str()) != 0)
+    throw Error(subject_,
+                fmt::format("cannot move the finished file into place ({})", std::strerror(errno)));
+  committed_ = true;
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+bool is_temporary_name(const std::string& name, std::string* target_name) {
+  if (name.size() < 2 || name[0] != '.') return false;
+  const std::size_t mark = name.rfind(kTempMark);
+  if (mark == std::string::npos || mark < 1) return false;
+  const std::size_t digits = mark + kTempMarkSize;
+  if (name.size() < digits + kRandomDigits) return false;
+  if (!is_hex(name.substr(digits, kRandomDigits))) return false;
+  const std::string ext = name.substr(digits + kRandomDigits);
+  if (!ext.empty() && (ext[0] != '.' || ext.find('/') != std::string::npos)) return false;
+  if (target_name) *target_name = name.substr(1, mark - 1) + ext;
+  return true;
+}
+
+void remove_temporaries(const std::string& dir,
+                        const std::function<bool(const std::string&)>& ours) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::string target;
+    if (!is_temporary_name(name, &target) || !ours(target)) continue;
+    struct stat st {};
+    if (::lstat(entry.path().c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_uid != ::geteuid())
+      continue;
+    fs::remove(entry.path(), ec);
+  }
+}
+
+// ---- the folder lock ----
+
+FolderLock::FolderLock(const std::string& folder) {
+  const std::string path = (fs::path(folder) / ".emaki.lock").string();
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd_ < 0)
+    throw Error(
+        path, fmt::format("cannot open the output folder's lock file ({})", std::strerror(errno)));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    std::string holder;
+    if (err == EWOULDBLOCK) {
+      char buf[256] = {};
+      const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
+      for (ssize_t i = 0; i < n; ++i) holder += (buf[i] >= 0x20 && buf[i] < 0x7f) ? buf[i] : ' ';
+      while (!holder.empty() && holder.back() == ' ') holder.pop_back();
+    }
+    ::close(fd_);
+    fd_ = -1;
+    if (err != EWOULDBLOCK)
+      throw Error(path, fmt::format("cannot lock the output folder ({})", std::strerror(err)));
+    throw Error(path, fmt::format("the output folder is in use by another emaki ({}); wait for "
+                                  "it to finish or stop it",
+                                  holder.empty() ? "holder unknown" : echo(holder)));
+  }
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  ::gmtime_r(&now, &tm);
+  char since[32] = {};
+  std::strftime(since, sizeof since, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  const std::string text = fmt::format("pid {} on {} since {}\n", ::getpid(), host, since);
+  if (::ftruncate(fd_, 0) == 0) {
+    const ssize_t ignored = ::pwrite(fd_, text.data(), text.size(), 0);
+    (void)ignored;  // the content is informational only
+  }
+}
+
+FolderLock::~FolderLock() {
+  // The file stays: removing it would let a third process lock a new file while a second one
+  // still waits on the old, unlinked one.
+  if (fd_ >= 0) {
+    const int ignored = ::ftruncate(fd_, 0);
+    (void)ignored;
+    ::close(fd_);
+  }
+}
+
+// ---- manifests ----
+
+std::optional<Manifest> read_manifest(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  // A manifest is a few hundred bytes; a large file is not one of ours.
+  if (st.st_size > (1 << 20)) return Manifest{"<not an emaki manifest>"};
+  std::ifstream f(path);
+  Manifest m;
+  std::string line;
+  while (std::getline(f, line)) m.push_back(line);
+  return m;
+}
+
+void write_manifest(const std::string& path, const Manifest& m) {
+  TempFile tmp(path, path);
+  std::string text;
+  for (const std::string& line : m) text += line + '\n';
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(tmp.fd(), text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error(path, "write failed (disk full?)");
+    done += std::size_t(n);
+  }
+  tmp.commit();
+}
+
+std::string manifest_difference(const Manifest& have, const Manifest& want) {
+  auto key_of = [](const std::string& line) { return line.substr(0, line.find(" = ")); };
+  auto value_of = [](const std::string& line) {
+    const std::size_t p = line.find(" = ");
+    return p == std::string::npos ? std::string() : line.substr(p + 3);
+  };
+  for (const std::string& w : want) {
+    const std::string key = key_of(w);
+    const std::string* found = nullptr;
+    for (const std::string& h : have)
+      if (key_of(h) == key) found = &h;
+    if (!found) return fmt::format("{} is new", echo(key));
+    if (*found != w)
+      return fmt::format("{} was {}, now {}", echo(key), echo(value_of(*found), 40),
+                         echo(value_of(w), 40));
+  }
+  if (have.size() != want.size()) return "the settings changed";
+  return {};
+}
+
+std::string file_digest(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return "missing";
+  // FNV-1a: fast enough for paintings and pass files, and only compared with itself (not a
+  // security boundary: a changed file is redone, a forged one is the user's own).
+  uint64_t h = 1469598103934665603ull;
+  std::vector<char> buf(1 << 20);
+  uint64_t total = 0;
+  while (f) {
+    f.read(buf.data(), std::streamsize(buf.size()));
+    const std::size_t n = std::size_t(f.gcount());
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= static_cast<unsigned char>(buf[i]);
+      h *= 1099511628211ull;
+    }
+    total += n;
+  }
+  return fmt::format("{:016x}-{}", h, total);
+}
+
+}  // namespace emaki::io

@@ -1,0 +1,123 @@
+#include "io/shot_manifest.h"
+
+#include <fmt/format.h>
+
+#include <glm/glm.hpp>
+
+namespace emaki::io {
+
+namespace {
+
+std::string v2(const glm::vec2& v) {
+  return fmt::format("{} {}", v.x, v.y);
+}
+std::string v3(const glm::vec3& v) {
+  return fmt::format("{} {} {}", v.x, v.y, v.z);
+}
+
+struct Lines {
+  Manifest m;
+  template <typename T>
+  void add(const std::string& key, const T& value) {
+    m.push_back(fmt::format("{} = {}", key, value));
+  }
+};
+
+void add_light(Lines& l, const std::string& p, const scene::LightSpec& s) {
+  l.add(p + "direction", v3(s.direction));
+  l.add(p + "camera_relative", s.camera_relative);
+  l.add(p + "softness", s.softness_deg);
+}
+
+// Everything that decides the guide passes of a frame.
+void add_source(Lines& l, const pipeline::Shot& shot) {
+  const pipeline::Source& s = shot.source;
+  l.add("size", fmt::format("{}x{}", s.width, s.height));
+  // The temporal chain starts at the first frame: every later frame depends on it.
+  l.add("source.first_frame", s.first_frame);
+  if (s.kind == pipeline::SourceKind::kScene) {
+    l.add("source.scene", s.scene_path);
+    l.add("source.scene.digest", file_digest(s.scene_path));
+    const scene::ShotSpec& sh = s.shot;
+    const scene::CameraSpec& c = sh.camera;
+    l.add("source.camera",
+          fmt::format("mode {} position {} target {} has_target {} azimuth {} elevation {} "
+                      "distance {} fov {} ortho {} {} node {} orbit {} dolly {} pan {} shift {}",
+                      int(c.mode), v3(c.position), v3(c.target), c.has_target, c.azimuth_deg,
+                      c.elevation_deg, c.distance, c.fov_deg, c.orthographic, c.ortho_height,
+                      c.gltf_node, c.orbit_deg, c.dolly, v3(c.pan), v2(c.shift)));
+    add_light(l, "source.light.", sh.light);
+    l.add("source.ground",
+          fmt::format("{} {} {} {} {}", sh.ground.enabled, sh.ground.size, sh.ground.height,
+                      sh.ground.auto_height, v3(sh.ground.color)));
+    l.add("source.background", v3(sh.background));
+    l.add("source.clip", sh.clip);
+    l.add("source.time", fmt::format("fps {} start {} loop {}", sh.fps, sh.start_time, sh.loop));
+    const render::RenderOptions& r = s.render;
+    l.add("source.render",
+          fmt::format("aa {} outline {} crease {} depth_jump {} shadow_map {}", r.aa,
+                      r.outline_width, r.crease_deg, r.depth_jump, r.shadow_map_size));
+  } else {
+    // A sequence's frames are not hashed (they may be gigabytes): its pattern and conventions.
+    l.add("source.sequence", s.pattern);
+    l.add("source.preset", fmt::format("{} {} world_normals {} z_up {} premultiplied {}", s.preset,
+                                       s.view_layer, s.world_normals, s.z_up, s.premultiplied));
+    for (const pipeline::ChannelMapping& m : s.channels)
+      l.add("source.channels." + m.pass, fmt::format("{}", fmt::join(m.channels, " ")));
+  }
+}
+
+void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
+  const std::string p = "exemplars." + e.name + ".";
+  l.add(p + "kind", int(e.kind));
+  l.add(p + "painting", e.painting);
+  l.add(p + "painting.digest", file_digest(e.painting));
+  if (e.kind == pipeline::ExemplarKind::kMatcap) {
+    const exemplar::ReferenceSpec& r = e.reference;
+    l.add(p + "reference",
+          fmt::format("center {} radius {} elevation {} horizon {} fov {} ground {} {} "
+                      "background {} aa {}",
+                      v2(r.center), r.radius, r.elevation_deg, r.horizon_row, r.fov_deg, r.ground,
+                      v3(r.ground_color), v3(r.background), e.aa));
+    add_light(l, p + "light.", r.light);
+  } else {
+    l.add(p + "passes", e.passes);
+    l.add(p + "passes.digest", file_digest(e.passes));
+  }
+}
+
+}  // namespace
+
+Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer) {
+  Lines l;
+  l.add("outputs_format", kOutputsFormat);
+  add_source(l, shot);
+  const std::string p = "layers." + layer.name + ".";
+  l.add(p + "exemplar", layer.exemplar);
+  if (const pipeline::Exemplar* e = shot.find_exemplar(layer.exemplar)) add_exemplar(l, *e);
+  for (const pipeline::GuideSpec& g : layer.guides) l.add(p + "guides." + g.pass, g.weight);
+  const pipeline::SynthSpec& s = layer.synth;
+  l.add(p + "synth", fmt::format("patch {} uniformity {} levels {} search_vote {} "
+                                 "patch_match {} seed {}",
+                                 s.patch_size, s.uniformity, s.pyramid_levels, s.search_vote_iters,
+                                 s.patch_match_iters, s.seed));
+  l.add(p + "single_colour", layer.single_colour);
+  l.add(p + "channel", layer.channel);
+  l.add(p + "temporal", fmt::format("{} weight {} guide {}", layer.temporal.enabled,
+                                    layer.temporal.weight, int(layer.temporal.guide)));
+  l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
+                                layer.mask.dilate, layer.mask.threshold));
+  return l.m;
+}
+
+Manifest frames_manifest(const pipeline::Shot& shot) {
+  Lines l;
+  l.add("outputs_format", kOutputsFormat);
+  l.add("size", fmt::format("{}x{}", shot.source.width, shot.source.height));
+  // The layered EXR's channels: one group per layer, in compositing order.
+  for (const pipeline::Layer& layer : shot.layers)
+    l.add("layers." + layer.name + ".single_colour", layer.single_colour);
+  return l.m;
+}
+
+}  // namespace emaki::io

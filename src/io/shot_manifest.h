@@ -1,0 +1,19 @@
+// The settings that made a shot's outputs, written beside them (io/output_store.h manifests):
+// a layer's frames depend on the source frames, the exemplar and the layer's synthesis settings;
+// the composited frames on the size and the layers' channel layout. Resuming compares them with
+// the shot as it is now, so that a changed size or layer setting redoes the work instead of
+// mixing old and new files.
+#pragma once
+
+#include "io/output_store.h"
+#include "pipeline/shot.h"
+
+namespace emaki::io {
+
+// Bumped when emaki's output files change meaning (channel layout, synthesis algorithm).
+inline constexpr int kOutputsFormat = 1;
+
+Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer);
+Manifest frames_manifest(const pipeline::Shot& shot);
+
+}  // namespace emaki::io
