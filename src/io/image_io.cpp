@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "io/exr_header.h"
 #include "io/oiio_backend.h"
 #include "io/png_io.h"
 #include "io/read_limits.h"
@@ -197,11 +199,30 @@ AnyImage pick_png_channels(AnyImage png, const std::string& subject, const ReadO
   return picked;
 }
 
+// OpenEXR allocates from header values while it opens a file, before OpenImageIO hands emaki a
+// spec to check: the header is walked first (exr_header.h).
+bool is_exr_file(const std::string& path) {
+  unsigned char magic[4] = {};
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  const std::size_t n = std::fread(magic, 1, 4, f);
+  std::fclose(f);
+  return detail::has_exr_magic(magic, n);
+}
+
+void check_exr_file(const std::string& path) {
+  if (lower_ext(path) != ".exr" && !is_exr_file(path)) return;
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) throw Error(path, "cannot open for reading");
+  detail::check_exr_header(f.get(), path);
+}
+
 }  // namespace
 
 std::vector<std::string> list_channels(const std::string& path) {
   check_readable(path);
   if (is_png(path)) return detail::read_png_header(path).channel_names;
+  check_exr_file(path);
   std::vector<std::string> names;
   std::lock_guard lock(detail::oiio_mutex());
   if (std::string e = detail::oiio_backend(path).list_channels({path}, names); !e.empty())
@@ -213,6 +234,7 @@ AnyImage read_image(const std::string& path, const ReadOptions& options) {
   check_readable(path);
   if (is_png(path) || lower_ext(path) == ".png")
     return pick_png_channels(detail::read_png(path), path, options);
+  check_exr_file(path);
   AnyImage result;
   std::lock_guard lock(detail::oiio_mutex());
   if (std::string e = detail::oiio_backend(path).read({path}, options, max_pixels(), result);
@@ -225,6 +247,9 @@ AnyImage read_image_memory(const void* data, std::size_t size, const std::string
                            const ReadOptions& options) {
   if (has_png_signature(static_cast<const unsigned char*>(data), size) || lower_ext(name) == ".png")
     return pick_png_channels(detail::read_png_memory(data, size, name), name, options);
+  if (lower_ext(name) == ".exr" ||
+      detail::has_exr_magic(static_cast<const unsigned char*>(data), size))
+    detail::check_exr_header(static_cast<const unsigned char*>(data), size, name);
   AnyImage result;
   std::lock_guard lock(detail::oiio_mutex());
   if (std::string e =

@@ -5,6 +5,8 @@
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -28,10 +30,6 @@ std::string first_line(std::string e, const std::string& fallback) {
   return e;
 }
 
-// More parts (EXR subimages) than this is taken as a corrupt or hostile file; named channels
-// are searched in every part, so the count bounds that search.
-constexpr int kMaxParts = 256;
-
 // The opened file. OpenImageIO keeps a pointer to the memory proxy, so the proxy lives beside
 // the input and outlives it (members are destroyed in reverse order).
 struct Opened {
@@ -39,14 +37,29 @@ struct Opened {
   std::unique_ptr<ImageInput> in;
 };
 
+// The OpenImageIO reader for a file name: only the formats emaki documents. OpenImageIO on its
+// own falls back to trying every reader it has (DICOM, camera raw, FFmpeg, ...) on a file that
+// its extension's reader refuses, which puts every one of them in front of hostile bytes.
+const char* format_for(const std::string& path) {
+  std::string ext = path.substr(std::min(path.size(), path.rfind('.')));
+  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == ".exr") return "openexr";
+  if (ext == ".tif" || ext == ".tiff") return "tiff";
+  if (ext == ".jpg" || ext == ".jpeg") return "jpeg";
+  return nullptr;
+}
+
 std::string open_source(const OiioSource& source, Opened& o) {
-  if (source.data) {
+  const char* format = format_for(source.path);
+  if (!format) return "unsupported image format (emaki reads .png, .exr, .tif and .jpg files)";
+  if (source.data)
     o.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(source.data, source.size);
-    o.in = ImageInput::open(source.path, nullptr, o.proxy.get());
-  } else {
-    o.in = ImageInput::open(source.path);
-  }
-  if (!o.in) return "cannot read image (" + first_line(OIIO::geterror(), "unknown format") + ")";
+  o.in = ImageInput::create(format, false, nullptr, o.proxy.get());
+  if (!o.in)
+    return "cannot read image (" + first_line(OIIO::geterror(), "no reader for the format") + ")";
+  ImageSpec spec;
+  if (!o.in->open(source.path, spec))
+    return "cannot read image (" + first_line(o.in->geterror(), "not a valid file") + ")";
   return {};
 }
 

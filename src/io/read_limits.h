@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <new>
+#include <optional>
 #include <string>
 
 #include "core/error.h"
@@ -15,6 +16,9 @@ namespace emaki::io::detail {
 // More channels than this in one image (or one EXR part) is taken as a corrupt or hostile
 // header: emaki's guides and styles have 1 to 4, multilayer render passes a few dozen.
 inline constexpr int kMaxChannels = 64;
+// More parts (EXR subimages) than this is taken as a corrupt or hostile file; named channels
+// are searched in every part, so the count also bounds that search.
+inline constexpr int kMaxParts = 256;
 
 // Throws Error(subject) unless an Image<T> of width x height x channels, as a header claims it,
 // fits the pixel budget and the memory the budget stands for. The pixel count alone is not
