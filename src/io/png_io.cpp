@@ -3,6 +3,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <cctype>
 #include <csetjmp>
 #include <cstdint>
 #include <cstdio>
@@ -123,6 +124,45 @@ struct FileCloser {
   }
 };
 
+// Walks the chunk layout (length, type, data, CRC) up to IEND before libpng sees the bytes.
+// libpng allocates a chunk's claimed length before reading it (a 10-byte tEXt that claims
+// 1.9 GB took 1.9 GB), and a truncated file would be found short only after its whole image
+// was allocated: a chunk must fit in what is left of the file, and the file must reach IEND.
+void check_chunks(PngSource& src, const std::string& subject) {
+  uint64_t size = src.size;
+  if (src.file) {
+    if (std::fseek(src.file, 0, SEEK_END) != 0) throw Error(subject, "cannot read the file");
+    const long end = std::ftell(src.file);
+    if (end < 0 || std::fseek(src.file, 0, SEEK_SET) != 0)
+      throw Error(subject, "cannot read the file");
+    size = uint64_t(end);
+  }
+  auto read_at = [&](uint64_t at, unsigned char* out, std::size_t n) {
+    if (!src.file) return std::memcpy(out, src.data + at, n), true;
+    return std::fseek(src.file, long(at), SEEK_SET) == 0 && std::fread(out, 1, n, src.file) == n;
+  };
+  unsigned char sig[8];
+  if (size < 8 || !read_at(0, sig, 8) || png_sig_cmp(sig, 0, 8) != 0)
+    throw Error(subject, "not a PNG file");
+  uint64_t pos = 8;
+  for (;;) {
+    unsigned char head[8];
+    if (pos + 12 > size || !read_at(pos, head, 8))
+      throw Error(subject, "corrupt or truncated PNG (the file ends before its IEND chunk)");
+    const uint64_t length = uint64_t(head[0]) << 24 | uint64_t(head[1]) << 16 |
+                            uint64_t(head[2]) << 8 | uint64_t(head[3]);
+    std::string type;
+    for (int i = 4; i < 8; ++i) type += std::isalpha(head[i]) ? char(head[i]) : '?';
+    if (length > PNG_UINT_31_MAX || length > size - pos - 12)
+      throw Error(subject, "corrupt or truncated PNG (chunk '" + type + "' claims " +
+                               std::to_string(length) + " bytes, past the end of the file)");
+    pos += 12 + length;
+    if (type == "IEND") break;
+  }
+  if (src.file && std::fseek(src.file, 0, SEEK_SET) != 0)
+    throw Error(subject, "cannot read the file");
+}
+
 template <typename T>
 Image<T> read_pixels(PngDecoder& d, const PngHeader& h, const std::string& subject) {
   Image<T> im = allocate_image<T>(subject, int(h.width), int(h.height), h.channels);
@@ -133,6 +173,7 @@ Image<T> read_pixels(PngDecoder& d, const PngHeader& h, const std::string& subje
 }
 
 AnyImage decode(PngSource& src, const std::string& subject, bool header_only) {
+  check_chunks(src, subject);
   PngDecoder d;
   d.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &d.error, on_error, on_warning);
   d.info = d.png ? png_create_info_struct(d.png) : nullptr;
