@@ -199,7 +199,8 @@ class Walker {
       // OpenEXR allocates width x height RGBA8 from the first 8 bytes.
       if (size < 8) fail("attribute '" + echo(name) + "' is too short for a preview");
       const uint64_t w = u32(), h = u32();
-      if (w * h * 4 != uint64_t(size) - 8)
+      const auto bytes = checked_mul<uint64_t>(w * h, 4);  // w, h < 2^32: w * h fits
+      if (!bytes || *bytes != uint64_t(size) - 8)
         fail("preview '" + echo(name) + "' of " + std::to_string(w) + "x" + std::to_string(h) +
              " does not match its attribute size");
       skip(uint64_t(size) - 8);
