@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <type_traits>
 #include <utility>
 
@@ -53,20 +54,24 @@ class Image {
     return *this;
   }
 
-  // Allocates zero-filled storage (zero so that row padding is deterministic too).
+  // Allocates zero-filled storage (zero so that row padding is deterministic too). Throws
+  // std::bad_alloc when the memory is not there: sizes can come from a file within a raised
+  // pixel budget, and the reader turns that into an error naming the file, not an abort. The
+  // image is left unchanged then.
   void reset(int width, int height, int channels) {
     CHECK_GE(width, 0);
     CHECK_GE(height, 0);
     CHECK_GT(channels, 0);
+    const std::size_t row_bytes = std::size_t(width) * channels * sizeof(T);
+    const std::size_t padded = (row_bytes + kRowAlign - 1) / kRowAlign * kRowAlign;
+    const std::size_t bytes = std::max<std::size_t>(padded * height, kRowAlign);
+    T* mem = static_cast<T*>(std::aligned_alloc(kRowAlign, bytes));
+    if (mem == nullptr) throw std::bad_alloc();
+    mem_.reset(mem);
     width_ = width;
     height_ = height;
     channels_ = channels;
-    const std::size_t row_bytes = std::size_t(width) * channels * sizeof(T);
-    const std::size_t padded = (row_bytes + kRowAlign - 1) / kRowAlign * kRowAlign;
     stride_ = std::ptrdiff_t(padded / sizeof(T));
-    const std::size_t bytes = std::max<std::size_t>(padded * height, kRowAlign);
-    mem_.reset(static_cast<T*>(std::aligned_alloc(kRowAlign, bytes)));
-    CHECK(mem_ != nullptr);
     std::memset(mem_.get(), 0, bytes);
   }
 

@@ -8,12 +8,16 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 
 #include "core/error.h"
+#include "core/limits.h"
+#include "io/exr_header.h"
 #include "io/oiio_backend.h"
 #include "io/output_store.h"
 #include "io/png_io.h"
+#include "io/read_limits.h"
 
 namespace emaki::io {
 namespace fs = std::filesystem;
@@ -146,9 +150,20 @@ std::string lower_ext(const std::string& path) {
 }
 
 void check_readable(const std::string& path) {
+  // No file has a longer path (PATH_MAX), and a path read from a shot file can be any size:
+  // name it capped rather than echo megabytes.
+  if (path.size() > 4096) throw Error(echo(path, 200), "path is too long");
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error(path, "file not found");
   if (fs::is_directory(path, ec)) throw Error(path, "is a folder, not an image file");
+  // A FIFO or a device (/dev/zero, /dev/stdin) has no end or no size to check against, and a
+  // reader would wait on it or read it forever.
+  if (!fs::is_regular_file(path, ec)) throw Error(path, "is not a regular file");
+}
+
+bool has_png_signature(const unsigned char* bytes, std::size_t n) {
+  static const unsigned char kSig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return n >= 8 && std::equal(bytes, bytes + 8, kSig);
 }
 
 bool is_png(const std::string& path) {
@@ -157,54 +172,91 @@ bool is_png(const std::string& path) {
   if (!f) return false;
   const std::size_t n = std::fread(sig, 1, 8, f);
   std::fclose(f);
-  static const unsigned char kSig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  return n == 8 && std::equal(sig, sig + 8, kSig);
+  return has_png_signature(sig, n);
+}
+
+// Picks channels by name from a PNG's R, G, B, A / Y, A (as float, like the EXR path).
+AnyImage pick_png_channels(AnyImage png, const std::string& subject, const ReadOptions& options) {
+  if (options.channels.empty()) return png;
+  std::vector<int> idx;
+  for (const auto& want : options.channels) {
+    auto it = std::find(png.channel_names.begin(), png.channel_names.end(), want);
+    if (it == png.channel_names.end()) {
+      std::string list;
+      for (const auto& n : png.channel_names) list += (list.empty() ? "" : ", ") + n;
+      throw Error(subject, "no channel '" + echo(want) + "' (the file has: " + list + ")");
+    }
+    idx.push_back(int(it - png.channel_names.begin()));
+  }
+  detail::check_image_alloc<float>(subject, png.width(), png.height(), int64_t(idx.size()));
+  Image<float> o =
+      detail::allocate_image<float>(subject, png.width(), png.height(), int(idx.size()));
+  for (int y = 0; y < o.height(); ++y)
+    for (int x = 0; x < o.width(); ++x)
+      for (std::size_t k = 0; k < idx.size(); ++k) o(x, y, int(k)) = png.value(x, y, idx[k]);
+  AnyImage picked;
+  picked.image = std::move(o);
+  picked.channel_names = options.channels;
+  return picked;
+}
+
+// OpenEXR allocates from header values while it opens a file, before OpenImageIO hands emaki a
+// spec to check: the header is walked first (exr_header.h).
+bool is_exr_file(const std::string& path) {
+  unsigned char magic[4] = {};
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  const std::size_t n = std::fread(magic, 1, 4, f);
+  std::fclose(f);
+  return detail::has_exr_magic(magic, n);
+}
+
+void check_exr_file(const std::string& path) {
+  if (lower_ext(path) != ".exr" && !is_exr_file(path)) return;
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) throw Error(path, "cannot open for reading");
+  detail::check_exr_header(f.get(), path);
 }
 
 }  // namespace
 
 std::vector<std::string> list_channels(const std::string& path) {
   check_readable(path);
-  if (is_png(path)) return detail::read_png(path).channel_names;
+  if (is_png(path)) return detail::read_png_header(path).channel_names;
+  check_exr_file(path);
   std::vector<std::string> names;
   std::lock_guard lock(detail::oiio_mutex());
-  if (std::string e = detail::oiio_backend(path).list_channels(path, names); !e.empty())
+  if (std::string e = detail::oiio_backend(path).list_channels({path}, names); !e.empty())
     throw Error(path, e);
   return names;
 }
 
 AnyImage read_image(const std::string& path, const ReadOptions& options) {
   check_readable(path);
+  if (is_png(path) || lower_ext(path) == ".png")
+    return pick_png_channels(detail::read_png(path), path, options);
+  check_exr_file(path);
   AnyImage result;
-  if (is_png(path) || lower_ext(path) == ".png") {
-    result = detail::read_png(path);
-    if (!options.channels.empty()) {
-      // Pick channels by name from the PNG's R, G, B, A / Y, A.
-      AnyImage picked;
-      std::vector<int> idx;
-      for (const auto& want : options.channels) {
-        auto it = std::find(result.channel_names.begin(), result.channel_names.end(), want);
-        if (it == result.channel_names.end()) {
-          std::string list;
-          for (const auto& n : result.channel_names) list += (list.empty() ? "" : ", ") + n;
-          throw Error(path, "no channel '" + want + "' (the file has: " + list + ")");
-        }
-        idx.push_back(int(it - result.channel_names.begin()));
-      }
-      Image<float> f = result.to_float();
-      Image<float> o(f.width(), f.height(), int(idx.size()));
-      for (int y = 0; y < f.height(); ++y)
-        for (int x = 0; x < f.width(); ++x)
-          for (std::size_t k = 0; k < idx.size(); ++k) o(x, y, int(k)) = f(x, y, idx[k]);
-      picked.image = std::move(o);
-      picked.channel_names = options.channels;
-      return picked;
-    }
-    return result;
-  }
   std::lock_guard lock(detail::oiio_mutex());
-  if (std::string e = detail::oiio_backend(path).read(path, options, result); !e.empty())
+  if (std::string e = detail::oiio_backend(path).read({path}, options, max_pixels(), result);
+      !e.empty())
     throw Error(path, e);
+  return result;
+}
+
+AnyImage read_image_memory(const void* data, std::size_t size, const std::string& name,
+                           const ReadOptions& options) {
+  if (has_png_signature(static_cast<const unsigned char*>(data), size) || lower_ext(name) == ".png")
+    return pick_png_channels(detail::read_png_memory(data, size, name), name, options);
+  if (lower_ext(name) == ".exr" ||
+      detail::has_exr_magic(static_cast<const unsigned char*>(data), size))
+    detail::check_exr_header(static_cast<const unsigned char*>(data), size, name);
+  AnyImage result;
+  std::lock_guard lock(detail::oiio_mutex());
+  if (std::string e =
+          detail::oiio_backend(name).read({name, data, size}, options, max_pixels(), result);
+      !e.empty())
+    throw Error(name, e);
   return result;
 }
 

@@ -4,6 +4,7 @@
 // its precision. Every write is atomic: a temporary file in the same folder, then a rename.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -38,10 +39,17 @@ struct ReadOptions {
   std::vector<std::string> channels;
 };
 
-// Throws emaki::Error naming the file on a missing, unreadable or corrupt file, or a channel
-// that is not in it (the message lists the channels the file has).
+// Throws emaki::Error naming the file on a missing, unreadable or corrupt file, a header whose
+// size is over the pixel budget (core/limits.h, `--max-pixels`) or otherwise implausible
+// (checked before any pixel memory is allocated), or a channel that is not in it (the message
+// lists the channels the file has).
 AnyImage read_image(const std::string& path, const ReadOptions& options = {});
 Image<float> read_image_float(const std::string& path, const ReadOptions& options = {});
+// The same from `size` bytes in memory (the fuzz targets, and callers that hold a file's
+// bytes). `name` names the bytes in errors, and its extension picks the format when the bytes
+// are not PNG (".exr", ".tif", ...).
+AnyImage read_image_memory(const void* data, std::size_t size, const std::string& name,
+                           const ReadOptions& options = {});
 
 // Lists the channel names of every part of a file.
 std::vector<std::string> list_channels(const std::string& path);

@@ -1,11 +1,21 @@
 // OpenImageIO reading and writing, compiled into the plugin module only.
 #include "io/oiio_backend.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <memory>
+#include <new>
+#include <type_traits>
+
+#include "core/error.h"
+#include "core/limits.h"
+#include "io/read_limits.h"
 
 namespace emaki::io::detail {
 namespace {
@@ -20,18 +30,102 @@ std::string first_line(std::string e, const std::string& fallback) {
   return e;
 }
 
+// The opened file. OpenImageIO keeps a pointer to the memory proxy, so the proxy lives beside
+// the input and outlives it (members are destroyed in reverse order).
+struct Opened {
+  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
+  std::unique_ptr<ImageInput> in;
+};
+
+// The OpenImageIO reader for a file name: only the formats emaki documents. OpenImageIO on its
+// own falls back to trying every reader it has (DICOM, camera raw, FFmpeg, ...) on a file that
+// its extension's reader refuses, which puts every one of them in front of hostile bytes.
+const char* format_for(const std::string& path) {
+  std::string ext = path.substr(std::min(path.size(), path.rfind('.')));
+  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == ".exr") return "openexr";
+  if (ext == ".tif" || ext == ".tiff") return "tiff";
+  if (ext == ".jpg" || ext == ".jpeg") return "jpeg";
+  return nullptr;
+}
+
+std::string open_source(const OiioSource& source, Opened& o) {
+  const char* format = format_for(source.path);
+  if (!format) return "unsupported image format (emaki reads .png, .exr, .tif and .jpg files)";
+  if (source.data)
+    o.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(source.data, source.size);
+  o.in = ImageInput::create(format, false, nullptr, o.proxy.get());
+  if (!o.in)
+    return "cannot read image (" + first_line(OIIO::geterror(), "no reader for the format") + ")";
+  ImageSpec spec;
+  if (!o.in->open(source.path, spec))
+    return "cannot read image (" + first_line(o.in->geterror(), "not a valid file") + ")";
+  return {};
+}
+
+std::string window_text(int x, int y, int w, int h) {
+  return fmt::format("origin ({}, {}) size {}x{}", x, y, w, h);
+}
+
+// Everything a part's header claims that sizes an allocation or a loop, checked before a pixel
+// of it is read: issue 9's 1 MB EXR whose data window said 30000x30000 took 22 GB before it
+// failed. Throws Error with an empty subject (the caller names the file).
+void check_spec(const ImageSpec& spec) {
+  if (spec.deep) throw Error("", "deep (multi-sample) images are not supported");
+  if (spec.depth != 1 || spec.full_depth > 1 || spec.tile_depth > 1)
+    throw Error("", "volume images are not supported");
+  if (spec.nchannels < 1 || spec.nchannels > kMaxChannels)
+    throw Error("", fmt::format("{} channels (emaki reads 1 to {})", spec.nchannels, kMaxChannels));
+  if (int64_t(spec.channelnames.size()) != int64_t(spec.nchannels))
+    throw Error("", "channel names do not match the channel count");
+  // OpenImageIO keeps each window as an int origin and size; the end must be an int too.
+  if (spec.width <= 0 || spec.height <= 0 || !checked_add(spec.x, spec.width) ||
+      !checked_add(spec.y, spec.height))
+    throw Error("", "data window (" + window_text(spec.x, spec.y, spec.width, spec.height) +
+                        ") is empty or overflows");
+  if (spec.full_width <= 0 || spec.full_height <= 0 || !checked_add(spec.full_x, spec.full_width) ||
+      !checked_add(spec.full_y, spec.full_height))
+    throw Error("", "display window (" +
+                        window_text(spec.full_x, spec.full_y, spec.full_width, spec.full_height) +
+                        ") is empty or overflows");
+  check_pixel_budget("", spec.width, spec.height);
+  if (spec.tile_width != 0 || spec.tile_height != 0) {
+    if (spec.tile_width <= 0 || spec.tile_height <= 0)
+      throw Error(
+          "", fmt::format("tile size {}x{} is not positive", spec.tile_width, spec.tile_height));
+    // The reader decodes whole tiles, so a row of tiles can hold more pixels than the image:
+    // the padded size must fit the budget too.
+    auto padded = [](int64_t size, int64_t tile) {
+      return (size + tile - 1) / tile * tile;  // both positive ints: cannot overflow int64
+    };
+    const auto n = checked_mul<int64_t>(padded(spec.width, spec.tile_width),
+                                        padded(spec.height, spec.tile_height));
+    if (!n || *n > max_pixels())
+      throw Error("", fmt::format("tiles of {}x{} make the {}x{} image exceed the pixel budget "
+                                  "of {} pixels",
+                                  spec.tile_width, spec.tile_height, spec.width, spec.height,
+                                  max_pixels()));
+  }
+}
+
+// Seeks to part `sub` (mip level 0); false past the last part, Error past kMaxParts.
+bool seek_part(ImageInput& in, int sub) {
+  if (sub >= kMaxParts) {
+    if (in.seek_subimage(sub, 0))
+      throw Error("", fmt::format("more than {} parts (subimages)", kMaxParts));
+    return false;
+  }
+  return in.seek_subimage(sub, 0);
+}
+
+// Reads channels [chbegin, chend) of a part straight into channels dst_c... of `out`, through
+// its padded rows: no second full-size buffer.
 template <typename T>
 bool read_into(ImageInput& in, int subimage, int chbegin, int chend, Image<T>& out, int dst_c,
                TypeDesc type) {
-  const ImageSpec& spec = in.spec();
-  const int nch = chend - chbegin;
-  std::vector<T> buf(std::size_t(spec.width) * spec.height * nch);
-  if (!in.read_image(subimage, 0, chbegin, chend, type, buf.data())) return false;
-  for (int y = 0; y < spec.height; ++y)
-    for (int x = 0; x < spec.width; ++x)
-      for (int c = 0; c < nch; ++c)
-        out(x, y, dst_c + c) = buf[(std::size_t(y) * spec.width + x) * nch + c];
-  return true;
+  return in.read_image(subimage, 0, chbegin, chend, type, &out(0, 0, dst_c),
+                       OIIO::stride_t(out.channels() * sizeof(T)),
+                       OIIO::stride_t(out.stride() * sizeof(T)));
 }
 
 std::string check_finite(const Image<float>& im) {
@@ -45,42 +139,45 @@ std::string check_finite(const Image<float>& im) {
   return {};
 }
 
-std::string list_impl(const std::string& path, std::vector<std::string>& names) {
-  auto in = ImageInput::open(path);
-  if (!in) return "cannot read image (" + first_line(OIIO::geterror(), "unknown format") + ")";
-  for (int sub = 0; in->seek_subimage(sub, 0); ++sub)
-    for (const auto& n : in->spec().channelnames) names.push_back(n);
+std::string list_checked(const OiioSource& source, std::vector<std::string>& names) {
+  Opened o;
+  if (std::string e = open_source(source, o); !e.empty()) return e;
+  for (int sub = 0; seek_part(*o.in, sub); ++sub) {
+    const ImageSpec& spec = o.in->spec();
+    if (spec.nchannels > kMaxChannels)
+      throw Error("", fmt::format("{} channels in part {} (emaki reads 1 to {})", spec.nchannels,
+                                  sub, kMaxChannels));
+    for (const auto& n : spec.channelnames) names.push_back(n);
+  }
   return {};
 }
 
-std::string read_impl(const std::string& path, const ReadOptions& options, AnyImage& result) {
-  auto in = ImageInput::open(path);
-  if (!in) return "cannot read image (" + first_line(OIIO::geterror(), "unknown format") + ")";
-  const std::string corrupt = "corrupt or truncated image";
+template <typename T>
+std::string read_whole(ImageInput& in, const ImageSpec& spec, TypeDesc type, AnyImage& result) {
+  check_image_alloc<T>("", spec.width, spec.height, spec.nchannels);
+  Image<T> im = allocate_image<T>("", spec.width, spec.height, spec.nchannels);
+  if (!read_into(in, 0, 0, spec.nchannels, im, 0, type))
+    return "corrupt or truncated image (" + first_line(in.geterror(), "read failed") + ")";
+  if constexpr (std::is_same_v<T, float>)
+    if (std::string e = check_finite(im); !e.empty()) return e;
+  result.image = std::move(im);
+  result.channel_names = spec.channelnames;
+  return {};
+}
+
+std::string read_checked(const OiioSource& source, const ReadOptions& options, AnyImage& result) {
+  Opened o;
+  if (std::string e = open_source(source, o); !e.empty()) return e;
+  ImageInput& in = *o.in;
   if (options.channels.empty()) {
-    const ImageSpec spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0) return "image has no pixels";
-    const int nch = spec.nchannels;
+    const ImageSpec spec = in.spec();
+    check_spec(spec);
     const auto bt = TypeDesc::BASETYPE(spec.format.basetype);
-    bool ok = true;
-    if (bt == TypeDesc::UINT8 || bt == TypeDesc::INT8) {
-      Image<uint8_t> im(spec.width, spec.height, nch);
-      ok = read_into(*in, 0, 0, nch, im, 0, TypeDesc::UINT8);
-      result.image = std::move(im);
-    } else if (bt == TypeDesc::UINT16 || bt == TypeDesc::INT16) {
-      Image<uint16_t> im(spec.width, spec.height, nch);
-      ok = read_into(*in, 0, 0, nch, im, 0, TypeDesc::UINT16);
-      result.image = std::move(im);
-    } else {
-      Image<float> im(spec.width, spec.height, nch);
-      ok = read_into(*in, 0, 0, nch, im, 0, TypeDesc::FLOAT);
-      if (ok)
-        if (std::string e = check_finite(im); !e.empty()) return e;
-      result.image = std::move(im);
-    }
-    if (!ok) return corrupt + " (" + first_line(in->geterror(), "read failed") + ")";
-    result.channel_names = spec.channelnames;
-    return {};
+    if (bt == TypeDesc::UINT8 || bt == TypeDesc::INT8)
+      return read_whole<uint8_t>(in, spec, TypeDesc::UINT8, result);
+    if (bt == TypeDesc::UINT16 || bt == TypeDesc::INT16)
+      return read_whole<uint16_t>(in, spec, TypeDesc::UINT16, result);
+    return read_whole<float>(in, spec, TypeDesc::FLOAT, result);
   }
   // Named channels: gather from whichever part holds each, as float.
   struct Where {
@@ -90,37 +187,68 @@ std::string read_impl(const std::string& path, const ReadOptions& options, AnyIm
   int width = -1, height = -1;
   for (const auto& want : options.channels) {
     bool found = false;
-    for (int sub = 0; in->seek_subimage(sub, 0) && !found; ++sub) {
-      const auto& spec = in->spec();
-      for (int c = 0; c < spec.nchannels; ++c) {
+    for (int sub = 0; !found && seek_part(in, sub); ++sub) {
+      const auto& spec = in.spec();
+      for (int c = 0; c < spec.nchannels && c < int(spec.channelnames.size()); ++c) {
         if (spec.channelnames[c] != want) continue;
+        check_spec(spec);
         where.push_back({sub, c});
         if (width < 0)
           width = spec.width, height = spec.height;
         else if (spec.width != width || spec.height != height)
-          return "channel '" + want + "' has a different size from the others";
+          return "channel '" + echo(want) + "' has a different size from the others";
         found = true;
         break;
       }
     }
     if (!found) {
       std::vector<std::string> names;
-      list_impl(path, names);
+      try {
+        list_checked(source, names);
+      } catch (const Error&) {
+      }
       std::string list;
       for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-      return "no channel '" + want + "' (the file has: " + list + ")";
+      return "no channel '" + echo(want) + "' (the file has: " + echo(list, 400) + ")";
     }
   }
-  Image<float> im(width, height, int(where.size()));
+  check_image_alloc<float>("", width, height, int64_t(where.size()));
+  Image<float> im = allocate_image<float>("", width, height, int(where.size()));
   for (std::size_t i = 0; i < where.size(); ++i) {
-    in->seek_subimage(where[i].sub, 0);
-    if (!read_into(*in, where[i].sub, where[i].ch, where[i].ch + 1, im, int(i), TypeDesc::FLOAT))
-      return corrupt + " (" + first_line(in->geterror(), "read failed") + ")";
+    if (!in.seek_subimage(where[i].sub, 0) ||
+        !read_into(in, where[i].sub, where[i].ch, where[i].ch + 1, im, int(i), TypeDesc::FLOAT))
+      return "corrupt or truncated image (" + first_line(in.geterror(), "read failed") + ")";
   }
   if (std::string e = check_finite(im); !e.empty()) return e;
   result.image = std::move(im);
   result.channel_names = options.channels;
   return {};
+}
+
+// The module's entry points turn every exception into a message: nothing is thrown across the
+// dlopen boundary, and OpenImageIO or OpenEXR running out of memory is an error, not an abort.
+template <typename F>
+std::string guarded(F&& f) {
+  try {
+    return f();
+  } catch (const Error& e) {
+    return e.what();
+  } catch (const std::bad_alloc&) {
+    return "not enough memory to read the image";
+  } catch (const std::exception& e) {
+    return first_line(e.what(), "read failed");
+  }
+}
+
+std::string read_impl(const OiioSource& source, const ReadOptions& options, int64_t max_pixels,
+                      AnyImage& result) {
+  // This module may hold its own copy of the budget (see OiioBackend): make it the caller's.
+  set_max_pixels(max_pixels);
+  return guarded([&] { return read_checked(source, options, result); });
+}
+
+std::string list_impl(const OiioSource& source, std::vector<std::string>& names) {
+  return guarded([&] { return list_checked(source, names); });
 }
 
 std::string write_impl(const std::string& path, ImageView<const float> image,

@@ -4,6 +4,8 @@
 // message (the caller names the file).
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -11,9 +13,21 @@
 
 namespace emaki::io::detail {
 
+// Where a read comes from: the file `path`, or, when `data` is set, `size` bytes in memory
+// (then `path` is only a name whose extension picks the format).
+struct OiioSource {
+  std::string path;
+  const void* data = nullptr;
+  std::size_t size = 0;
+};
+
 struct OiioBackend {
-  std::string (*read)(const std::string& path, const ReadOptions& options, AnyImage& out);
-  std::string (*list_channels)(const std::string& path, std::vector<std::string>& out);
+  // `max_pixels` is the caller's pixel budget (core/limits.h), passed because the module, loaded
+  // with RTLD_LOCAL, may hold its own copy of the process-wide setting. Every header (data
+  // window, tiles, channels, parts) is checked against it before a pixel is read.
+  std::string (*read)(const OiioSource& source, const ReadOptions& options, int64_t max_pixels,
+                      AnyImage& out);
+  std::string (*list_channels)(const OiioSource& source, std::vector<std::string>& out);
   // Writes to `path` exactly (the caller makes it atomic). `type`: 0 u8, 1 u16, 2 half, 3 float.
   std::string (*write)(const std::string& path, ImageView<const float> image,
                        const std::vector<std::string>& channel_names, int type);

@@ -4,6 +4,7 @@
 // only when another format is read or written (see image_io.cpp).
 #pragma once
 
+#include <cstddef>
 #include <cstdio>
 #include <string>
 
@@ -12,7 +13,13 @@
 namespace emaki::io::detail {
 
 // 8/16-bit gray, gray+alpha, RGB, RGBA (palette and low bit depths are expanded to 8-bit).
+// The size in the header is checked against the pixel budget (core/limits.h) before any pixel
+// memory is allocated. Errors throw emaki::Error naming `path` (or `name`).
 AnyImage read_png(const std::string& path);
+// The same from bytes in memory; `name` is the error subject.
+AnyImage read_png_memory(const void* data, std::size_t size, const std::string& name);
+// Only the header: channel names (R, G, B, A / Y, A) with an empty image.
+AnyImage read_png_header(const std::string& path);
 // Writes 8- or 16-bit PNG with 1-4 channels, values clamped to [0, 1]. `path` is written as is
 // (the caller makes it atomic).
 void write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
