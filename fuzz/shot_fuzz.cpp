@@ -24,7 +24,8 @@ namespace {
 
 std::string make_home() {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("emaki_shot_fuzz_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("emaki_shot_fuzz_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   for (const char* name :
        {"scene.glb", "painting.png", "paper.png", "passes.exr", "frame_0000.exr"})

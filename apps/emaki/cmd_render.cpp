@@ -26,9 +26,9 @@ namespace fs = std::filesystem;
 // "A-B" or "A", each in [0, kMaxFrame], at most kMaxFrameCount frames: parsed as 64-bit and
 // bounded, so no frame arithmetic downstream can overflow.
 void parse_frames(const std::string& text, int& first, int& last) {
-  const std::string usage = fmt::format(
-      "expects A-B or A (frame numbers in [0, {}], at most {} frames), got '{}'", kMaxFrame,
-      kMaxFrameCount, echo(text));
+  const std::string usage =
+      fmt::format("expects A-B or A (frame numbers in [0, {}], at most {} frames), got '{}'",
+                  kMaxFrame, kMaxFrameCount, echo(text));
   long long a = 0, b = 0;
   try {
     std::size_t pos = 0;

@@ -44,7 +44,8 @@ void parse_frames(const std::string& text, pipeline::RunOptions& o) {
   }
   if (o.first_frame < 0 || o.last_frame < 0 || o.first_frame > kMaxFrame ||
       o.last_frame > kMaxFrame)
-    throw Error("--frames", fmt::format("frames must be in [0, {}], got '{}'", kMaxFrame, echo(text)));
+    throw Error("--frames",
+                fmt::format("frames must be in [0, {}], got '{}'", kMaxFrame, echo(text)));
 }
 
 std::vector<std::string> split_commas(const std::string& text) {

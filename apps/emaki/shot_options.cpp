@@ -51,8 +51,7 @@ void parse_size(const std::string& option, const std::string& text, int& width, 
     height = std::stoi(text.substr(x + 1), &p2);
     if (p1 != x || p2 != text.size() - x - 1) throw std::invalid_argument(text);
   } catch (const std::exception&) {
-    throw Error(option,
-                fmt::format("expects WIDTHxHEIGHT, e.g. 1280x720, got '{}'", echo(text)));
+    throw Error(option, fmt::format("expects WIDTHxHEIGHT, e.g. 1280x720, got '{}'", echo(text)));
   }
   if (width < 1 || height < 1 || width > 16384 || height > 16384)
     throw Error(option,
@@ -115,8 +114,9 @@ void ShotOptions::add_to(CLI::App& app, bool with_motion) {
     app.add_option("--orbit", orbit,
                    "camera turns this many degrees around the target over the frame range")
         ->capture_default_str();
-    app.add_option("--dolly", dolly,
-                   "camera distance to the target is multiplied by this at the last frame, [0.01, 100]")
+    app.add_option(
+           "--dolly", dolly,
+           "camera distance to the target is multiplied by this at the last frame, [0.01, 100]")
         ->capture_default_str();
     app.add_option("--pan", pan, "camera and target move by X,Y,Z over the frame range");
     app.add_option("--gltf-camera", gltf_camera,

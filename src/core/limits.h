@@ -31,7 +31,9 @@ inline std::atomic<bool>& max_pixels_pinned_slot() {
 }  // namespace detail
 
 // The process-wide pixel budget (`--max-pixels` on the CLI, `limits.max_pixels` in a shot).
-inline int64_t max_pixels() { return detail::max_pixels_slot().load(std::memory_order_relaxed); }
+inline int64_t max_pixels() {
+  return detail::max_pixels_slot().load(std::memory_order_relaxed);
+}
 // Sets the budget and pins it: the command line's --max-pixels wins over a shot file's.
 inline void set_max_pixels(int64_t n) {
   detail::max_pixels_slot().store(n, std::memory_order_relaxed);

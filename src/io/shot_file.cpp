@@ -184,8 +184,8 @@ class Reader {
                     fmt::format("expected {}, found {} in it", expected, type_name(e)));
       if (!std::isfinite(out.back())) throw Error(key_path(key), "values must be finite");
       if (std::abs(out.back()) > kMaxMagnitude)
-        throw Error(key_path(key), fmt::format("values must be within +-{}, got {}", kMaxMagnitude,
-                                               out.back()));
+        throw Error(key_path(key),
+                    fmt::format("values must be within +-{}, got {}", kMaxMagnitude, out.back()));
     }
     if ((count > 0 && int(out.size()) != count) || out.empty())
       throw Error(key_path(key), fmt::format("expected {}, got {} value{}", expected, out.size(),
@@ -467,7 +467,8 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       for (const std::string& ch : blender_channels(s.view_layer))
         if (!has(ch))
           missing(r.key_path("preset"), ch,
-                  fmt::format("a pass preset 'blender' reads from view layer '{}'", echo(s.view_layer)));
+                  fmt::format("a pass preset 'blender' reads from view layer '{}'",
+                              echo(s.view_layer)));
       alpha_channel = s.view_layer + ".Combined.A";
     } else {
       for (const render::PassInfo& p : render::pass_table()) {
@@ -747,7 +748,7 @@ int declared_line(const toml::node& n) {
 
 // toml++ recurses once per level of dotted key, table header, inline table and array (and so
 // does destroying the tree): a 400 KB file of `a.a.a...= 1` overflows the stack. This cheap
-// scan bounds the depth first. Depth here is open [ and { plus the dots of the key being read;
+// scan bounds the depth first. Depth here is 1 + open [ and { + the dots of the key being read;
 // strings and comments are skipped, and the dot count restarts at every = , newline or bracket,
 // so the dot of a float (1.5) adds one level at most.
 void check_nesting(std::string_view text, const std::string& path) {
@@ -796,7 +797,7 @@ void check_nesting(std::string_view text, const std::string& path) {
       }
       case '[':
       case '{':
-        if (++brackets + dots > kMaxShotDepth) too_deep();
+        if (++brackets + dots + 1 > kMaxShotDepth) too_deep();
         dots = 0;
         break;
       case ']':
@@ -809,7 +810,7 @@ void check_nesting(std::string_view text, const std::string& path) {
         dots = 0;
         break;
       case '.':
-        if (brackets + ++dots > kMaxShotDepth) too_deep();
+        if (brackets + ++dots + 1 > kMaxShotDepth) too_deep();
         break;
       default:
         break;
@@ -968,8 +969,8 @@ Shot load_shot(const std::string& path) {
   if (in.bad()) throw Error(path, "cannot read the shot file");
   text.resize(std::size_t(in.gcount()));
   if (text.size() > kMaxShotBytes)
-    throw Error(path, fmt::format("is larger than {} bytes, the most a shot file may hold",
-                                  kMaxShotBytes));
+    throw Error(
+        path, fmt::format("is larger than {} bytes, the most a shot file may hold", kMaxShotBytes));
   return parse_shot(text, path);
 }
 
