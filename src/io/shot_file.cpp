@@ -591,10 +591,11 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
     Reader g(*t, r.key_path("guides"), passes);
     l.guides.clear();
     // Guides keep the file's order so that results do not depend on how toml++ sorts keys.
-    std::vector<std::pair<std::string, int>> order;
+    // (line, column): as int64, since a 1 MB file may hold a million lines.
+    std::vector<std::pair<std::string, int64_t>> order;
     for (const auto& [k, v] : *t)
-      order.emplace_back(std::string(k.str()),
-                         int(v.source().begin.line) * 10000 + int(v.source().begin.column));
+      order.emplace_back(std::string(k.str()), int64_t(v.source().begin.line) * 100000000 +
+                                                   int64_t(v.source().begin.column));
     std::stable_sort(order.begin(), order.end(),
                      [](auto& a, auto& b) { return a.second < b.second; });
     for (const auto& [pass, line] : order) {
