@@ -12,6 +12,7 @@
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
 #include "render/passes.h"
@@ -22,22 +23,29 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// "A-B" or "A", each in [0, kMaxFrame], at most kMaxFrameCount frames: parsed as 64-bit and
+// bounded, so no frame arithmetic downstream can overflow.
 void parse_frames(const std::string& text, int& first, int& last) {
+  const std::string usage =
+      fmt::format("expects A-B or A (frame numbers in [0, {}], at most {} frames), got '{}'",
+                  kMaxFrame, kMaxFrameCount, echo(text));
+  long long a = 0, b = 0;
   try {
     std::size_t pos = 0;
     const std::size_t dash = text.find('-', 1);
-    first = std::stoi(text.substr(0, dash), &pos);
+    a = std::stoll(text.substr(0, dash), &pos);
     if (pos != std::min(dash, text.size())) throw std::invalid_argument(text);
-    last = first;
+    b = a;
     if (dash != std::string::npos) {
-      last = std::stoi(text.substr(dash + 1), &pos);
+      b = std::stoll(text.substr(dash + 1), &pos);
       if (pos != text.size() - dash - 1) throw std::invalid_argument(text);
     }
   } catch (const std::exception&) {
-    throw Error("--frames", fmt::format("expects A-B or A (frame numbers >= 0), got '{}'", text));
+    throw Error("--frames", usage);
   }
-  if (first < 0 || last < first)
-    throw Error("--frames", fmt::format("expects 0 <= A <= B, got '{}'", text));
+  if (a < 0 || b < a || b > kMaxFrame || b - a >= kMaxFrameCount) throw Error("--frames", usage);
+  first = int(a);
+  last = int(b);
 }
 
 void make_dir(const std::string& option, const fs::path& dir) {
@@ -79,7 +87,8 @@ int run_render(const Args& args) {
   app.add_option("scene", scene_path, "the scene, .gltf or .glb")->required();
   app.add_option(
          "--frames", frames,
-         "frame range A-B (or one frame A), A >= 0; frame f is at clip start + --start + f / fps")
+         "frame range A-B (or one frame A), 0 <= A <= B <= 10000000, at most 1000000 frames; "
+         "frame f is at clip start + --start + f / fps")
       ->capture_default_str();
   app.add_option("--out", out_dir, "output folder (created if missing)")->required();
   app.add_option("--clip", clip, "animation clip by name; default: the first clip");
@@ -88,7 +97,7 @@ int run_render(const Args& args) {
                  "seconds into the clip of frame 0, >= 0 (and within the clip)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--fps", fps, "frames per second, > 0")
+  app.add_option("--fps", fps, "frames per second, [0.01, 1000]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   so.add_to(app, true);
@@ -102,6 +111,8 @@ int run_render(const Args& args) {
   render::RenderOptions options;
   so.resolve(shot, options);
   parse_frames(frames, shot.first_frame, shot.last_frame);
+  check_number("--fps", fps, render::kMinFps, render::kMaxFps);
+  check_number("--start", start_time, 0.0f, 1e7f);
   shot.fps = fps;
   shot.start_time = start_time;
   shot.clip = clip;

@@ -12,6 +12,7 @@
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "io/shot_file.h"
 #include "io/shot_inputs.h"
@@ -38,10 +39,13 @@ void parse_frames(const std::string& text, pipeline::RunOptions& o) {
       if (p != text.size() - dash - 1) throw std::invalid_argument(text);
     }
   } catch (const std::exception&) {
-    throw Error("--frames", fmt::format("expects FIRST-LAST or FRAME, e.g. 0-47, got '{}'", text));
+    throw Error("--frames",
+                fmt::format("expects FIRST-LAST or FRAME, e.g. 0-47, got '{}'", echo(text)));
   }
-  if (o.first_frame < 0 || o.last_frame < 0)
-    throw Error("--frames", fmt::format("frames must be >= 0, got '{}'", text));
+  if (o.first_frame < 0 || o.last_frame < 0 || o.first_frame > kMaxFrame ||
+      o.last_frame > kMaxFrame)
+    throw Error("--frames",
+                fmt::format("frames must be in [0, {}], got '{}'", kMaxFrame, echo(text)));
 }
 
 std::vector<std::string> split_commas(const std::string& text) {

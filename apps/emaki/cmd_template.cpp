@@ -72,6 +72,12 @@ int run_template(const Args& args) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   if (parse_cli(app, args)) return 0;
+  // CLI11's ranges let nan through; every float option is checked finite and in range here.
+  check_number("--elevation", elevation, -80.0f, 80.0f);
+  check_number("--fov", fov, 1.0f, 120.0f);
+  check_number("--softness", softness, 0.0f, 45.0f);
+  check_number("--outline-width", outline_width, 0.0f, 16.0f);
+  if (app.count("--horizon") > 0) check_number("--horizon", horizon);
   set_thread_count(threads);
 
   exemplar::ReferenceSpec spec;

@@ -7,9 +7,15 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 
 namespace emaki::app {
+
+void check_number(const std::string& option, float value, float lo, float hi) {
+  if (!(std::isfinite(value) && value >= lo && value <= hi))
+    throw Error(option, fmt::format("must be a finite number in [{}, {}], got {}", lo, hi, value));
+}
 
 std::vector<float> parse_floats(const std::string& option, const std::string& text, int count) {
   std::vector<float> out;
@@ -20,15 +26,19 @@ std::vector<float> parse_floats(const std::string& option, const std::string& te
     try {
       std::size_t pos = 0;
       const float v = std::stof(item, &pos);
-      if (pos != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+      if (pos != item.size() || !std::isfinite(v) || std::abs(v) > kMaxOptionMagnitude)
+        throw std::invalid_argument(item);
       out.push_back(v);
     } catch (const std::exception&) {
-      throw Error(option, fmt::format("expects {} comma-separated numbers, got '{}'", count, text));
+      throw Error(option, fmt::format("expects {} comma-separated finite numbers within +-{}, "
+                                      "got '{}'",
+                                      count, kMaxOptionMagnitude, echo(text)));
     }
     start = end + 1;
   }
   if (int(out.size()) != count)
-    throw Error(option, fmt::format("expects {} comma-separated numbers, got '{}'", count, text));
+    throw Error(option,
+                fmt::format("expects {} comma-separated numbers, got '{}'", count, echo(text)));
   return out;
 }
 
@@ -41,10 +51,12 @@ void parse_size(const std::string& option, const std::string& text, int& width, 
     height = std::stoi(text.substr(x + 1), &p2);
     if (p1 != x || p2 != text.size() - x - 1) throw std::invalid_argument(text);
   } catch (const std::exception&) {
-    throw Error(option, fmt::format("expects WIDTHxHEIGHT, e.g. 1280x720, got '{}'", text));
+    throw Error(option, fmt::format("expects WIDTHxHEIGHT, e.g. 1280x720, got '{}'", echo(text)));
   }
   if (width < 1 || height < 1 || width > 16384 || height > 16384)
-    throw Error(option, fmt::format("width and height must be in [1, 16384], got '{}'", text));
+    throw Error(option,
+                fmt::format("width and height must be in [1, 16384], got '{}'", echo(text)));
+  check_pixel_budget(option, width, height);
 }
 
 bool parse_cli(CLI::App& app, const Args& args) {
@@ -102,9 +114,9 @@ void ShotOptions::add_to(CLI::App& app, bool with_motion) {
     app.add_option("--orbit", orbit,
                    "camera turns this many degrees around the target over the frame range")
         ->capture_default_str();
-    app.add_option("--dolly", dolly,
-                   "camera distance to the target is multiplied by this at the last frame, > 0")
-        ->check(CLI::PositiveNumber)
+    app.add_option(
+           "--dolly", dolly,
+           "camera distance to the target is multiplied by this at the last frame, [0.01, 100]")
         ->capture_default_str();
     app.add_option("--pan", pan, "camera and target move by X,Y,Z over the frame range");
     app.add_option("--gltf-camera", gltf_camera,
@@ -137,6 +149,18 @@ void ShotOptions::add_to(CLI::App& app, bool with_motion) {
 
 void ShotOptions::resolve(scene::ShotSpec& shot, render::RenderOptions& options) const {
   parse_size("--size", size, options.width, options.height);
+  // Every float option, finite and in its documented range, before anything is loaded.
+  check_number("--outline-width", outline_width, 0.0f, 16.0f);
+  check_number("--crease", crease_deg, 0.0f, 180.0f);
+  check_number("--azimuth", azimuth);
+  check_number("--elevation", elevation, -89.0f, 89.0f);
+  check_number("--distance", distance, 0.0f);
+  check_number("--fov", fov, 1.0f, 170.0f);
+  check_number("--ortho", ortho, 0.0f);
+  check_number("--orbit", orbit);
+  check_number("--dolly", dolly, 0.01f, 100.0f);
+  check_number("--softness", softness, 0.0f, 45.0f);
+  check_number("--ground-size", ground_size, 0.0f);
   options.aa = aa;
   options.outline_width = outline_width;
   options.crease_deg = crease_deg;

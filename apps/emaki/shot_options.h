@@ -38,7 +38,17 @@ struct ShotOptions {
   void resolve(scene::ShotSpec& shot, render::RenderOptions& options) const;
 };
 
-// Parses "X,Y,Z"-style lists; throws emaki::Error naming `option`.
+// Scene units, pixels, degrees and seconds an option may give: at most this in magnitude (as in
+// a shot file), so that squares stay within a float.
+inline constexpr float kMaxOptionMagnitude = 1e9f;
+
+// Throws emaki::Error naming `option` unless `value` is finite and within [lo, hi]. CLI11's
+// own range checks let nan through (every comparison with it is false) and accept inf.
+void check_number(const std::string& option, float value, float lo = -kMaxOptionMagnitude,
+                  float hi = kMaxOptionMagnitude);
+
+// Parses "X,Y,Z"-style lists (finite, within +-kMaxOptionMagnitude); throws emaki::Error naming
+// `option`.
 std::vector<float> parse_floats(const std::string& option, const std::string& text, int count);
 // Parses "WxH".
 void parse_size(const std::string& option, const std::string& text, int& width, int& height);

@@ -24,15 +24,33 @@ inline std::atomic<int64_t>& max_pixels_slot() {
   static std::atomic<int64_t> v{kDefaultMaxPixels};
   return v;
 }
+inline std::atomic<bool>& max_pixels_pinned_slot() {
+  static std::atomic<bool> v{false};
+  return v;
+}
 }  // namespace detail
 
 // The process-wide pixel budget (`--max-pixels` on the CLI, `limits.max_pixels` in a shot).
 inline int64_t max_pixels() {
   return detail::max_pixels_slot().load(std::memory_order_relaxed);
 }
+// Sets the budget and pins it: the command line's --max-pixels wins over a shot file's.
 inline void set_max_pixels(int64_t n) {
   detail::max_pixels_slot().store(n, std::memory_order_relaxed);
+  detail::max_pixels_pinned_slot().store(true, std::memory_order_relaxed);
 }
+// A file's budget (a shot's `limits.max_pixels`): applies unless set_max_pixels pinned one.
+inline void set_max_pixels_from_file(int64_t n) {
+  if (!detail::max_pixels_pinned_slot().load(std::memory_order_relaxed))
+    detail::max_pixels_slot().store(n, std::memory_order_relaxed);
+}
+
+// Frame numbers and counts from a shot file or an option (documented in docs/shot_file.md):
+// frames lie in [0, kMaxFrame] and a range holds at most kMaxFrameCount frames, so frame
+// arithmetic (f - 1, f + count, first + last) never overflows an int and no loop over a range
+// runs for hours before its first progress line.
+inline constexpr int kMaxFrame = 10'000'000;
+inline constexpr int kMaxFrameCount = 1'000'000;
 
 // Overflow-checked arithmetic: nullopt when the exact result does not fit in T.
 template <typename T>

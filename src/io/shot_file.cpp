@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/image_io.h"
 #include "io/shot_inputs.h"
 #include "io/studio_passes.h"
@@ -78,14 +79,19 @@ std::string join(const std::vector<std::string>& v) {
 // the closest known key as a suggestion.
 class Reader {
  public:
+  // Scene units, pixels, degrees and seconds beyond this are typos or attacks, and their
+  // squares would overflow a float.
+  static constexpr double kMaxMagnitude = 1e9;
+
   // Unknown keys are reported first: a typo explains the errors that would follow from it.
   Reader(const toml::table& table, std::string path, std::vector<std::string> known)
       : table_(table), path_(std::move(path)), known_(std::move(known)) {
     check_unknown_keys();
   }
 
+  // Keys come from the file: an unknown one may be megabytes long, so it is echoed capped.
   std::string key_path(std::string_view key) const {
-    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+    return path_.empty() ? echo(key) : path_ + "." + echo(key);
   }
   const std::string& path() const { return path_; }
 
@@ -99,8 +105,10 @@ class Reader {
     throw Error(key_path(key), fmt::format("expected {}, got {}", expected, type_name(n)));
   }
 
-  double number(std::string_view key, double fallback, double lo = -HUGE_VAL,
-                double hi = HUGE_VAL) {
+  // Every number must be finite and, unless a key says otherwise, within +-kMaxMagnitude: inf,
+  // nan or 1e300 in a camera value would otherwise render blank frames with exit 0.
+  double number(std::string_view key, double fallback, double lo = -kMaxMagnitude,
+                double hi = kMaxMagnitude) {
     const toml::node* n = node(key);
     if (!n) return fallback;
     double v;
@@ -110,19 +118,27 @@ class Reader {
       v = *f;
     else
       type_error(key, *n, "a number");
+    if (!std::isfinite(v)) throw Error(key_path(key), fmt::format("must be finite, got {}", v));
     check_range(key, v, lo, hi);
     return v;
   }
-  float real(std::string_view key, float fallback, double lo = -HUGE_VAL, double hi = HUGE_VAL) {
+  float real(std::string_view key, float fallback, double lo = -kMaxMagnitude,
+             double hi = kMaxMagnitude) {
     return float(number(key, fallback, lo, hi));
   }
-  int integer(std::string_view key, int fallback, int64_t lo = INT32_MIN, int64_t hi = INT32_MAX) {
+  // An integer in [lo, hi], compared as int64 (a double would round 2^53 + 1).
+  int64_t integer64(std::string_view key, int64_t fallback, int64_t lo, int64_t hi) {
     const toml::node* n = node(key);
     if (!n) return fallback;
     auto i = n->value_exact<int64_t>();
     if (!i) type_error(key, *n, "an integer");
-    check_range(key, double(*i), double(lo), double(hi));
-    return int(*i);
+    if (*i < lo || *i > hi)
+      throw Error(key_path(key), fmt::format("must be in [{}, {}], got {}", lo, hi, *i));
+    return *i;
+  }
+  int integer(std::string_view key, int fallback, int64_t lo = INT32_MIN, int64_t hi = INT32_MAX) {
+    return int(integer64(key, fallback, std::max<int64_t>(lo, INT32_MIN),
+                         std::min<int64_t>(hi, INT32_MAX)));
   }
   bool boolean(std::string_view key, bool fallback) {
     const toml::node* n = node(key);
@@ -142,9 +158,9 @@ class Reader {
                      const std::vector<std::string>& options) {
     const std::string s = string(key, fallback);
     if (std::find(options.begin(), options.end(), s) == options.end()) {
-      const std::string near = closest_key(s, options);
+      const std::string near = s.size() > 256 ? std::string() : closest_key(s, options);
       throw Error(key_path(key),
-                  fmt::format("'{}' is not one of {}{}", s, join(options),
+                  fmt::format("'{}' is not one of {}{}", echo(s), join(options),
                               near.empty() ? "" : fmt::format(" — did you mean '{}'?", near)));
     }
     return s;
@@ -167,6 +183,9 @@ class Reader {
         throw Error(key_path(key),
                     fmt::format("expected {}, found {} in it", expected, type_name(e)));
       if (!std::isfinite(out.back())) throw Error(key_path(key), "values must be finite");
+      if (std::abs(out.back()) > kMaxMagnitude)
+        throw Error(key_path(key),
+                    fmt::format("values must be within +-{}, got {}", kMaxMagnitude, out.back()));
     }
     if ((count > 0 && int(out.size()) != count) || out.empty())
       throw Error(key_path(key), fmt::format("expected {}, got {} value{}", expected, out.size(),
@@ -177,7 +196,7 @@ class Reader {
     if (!has(key)) return fallback;
     const std::vector<float> c = numbers(key, 3);
     for (float v : c)
-      if (v < 0.0f || v > 1.0f)
+      if (!(v >= 0.0f && v <= 1.0f))
         throw Error(key_path(key), fmt::format("colour components must be in [0, 1], got {}", v));
     return {c[0], c[1], c[2]};
   }
@@ -211,16 +230,8 @@ class Reader {
 
  private:
   void check_range(std::string_view key, double v, double lo, double hi) {
-    if (!(v >= lo && v <= hi)) {
-      std::string range;
-      if (lo == -HUGE_VAL)
-        range = fmt::format("<= {}", hi);
-      else if (hi == HUGE_VAL)
-        range = fmt::format(">= {}", lo);
-      else
-        range = fmt::format("in [{}, {}]", lo, hi);
-      throw Error(key_path(key), fmt::format("must be {}, got {}", range, v));
-    }
+    if (!(v >= lo && v <= hi))
+      throw Error(key_path(key), fmt::format("must be in [{}, {}], got {}", lo, hi, v));
   }
 
   const toml::table& table_;
@@ -245,7 +256,7 @@ struct Context {
     const std::string p = resolve(raw);
     std::error_code ec;
     if (!fs::is_regular_file(p, ec))
-      throw Error(r.key_path(key), fmt::format("no such file '{}'", p));
+      throw Error(r.key_path(key), fmt::format("no such file '{}'", echo(p)));
     return p;
   }
 };
@@ -256,19 +267,28 @@ std::vector<std::string> pass_names() {
   return v;
 }
 
+// The frame-number pattern is parsed here, never handed to printf: a width from the file
+// ("%2000000000d") would otherwise ask for gigabytes of padding.
 void check_pattern(const std::string& key, const std::string& pattern) {
   int count = 0;
   for (std::size_t i = 0; i < pattern.size(); ++i) {
     if (pattern[i] != '%') continue;
     std::size_t j = i + 1;
-    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j]))) ++j;
+    int width = 0;
+    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j]))) {
+      width = width * 10 + (pattern[j++] - '0');
+      if (width > kMaxFrameWidth)
+        throw Error(key, fmt::format("'{}': the frame number's width must be at most {}",
+                                     echo(pattern), kMaxFrameWidth));
+    }
     if (j >= pattern.size() || pattern[j] != 'd')
-      throw Error(key, fmt::format("'{}': only %d or %0Nd may follow '%'", pattern));
+      throw Error(key, fmt::format("'{}': only %d or %0Nd may follow '%'", echo(pattern)));
     ++count;
     i = j;
   }
   if (count != 1)
-    throw Error(key, fmt::format("'{}' must contain exactly one frame number (%04d)", pattern));
+    throw Error(key,
+                fmt::format("'{}' must contain exactly one frame number (%04d)", echo(pattern)));
 }
 
 // ---- source ----
@@ -282,11 +302,11 @@ void parse_camera(Reader& r, scene::CameraSpec& c) {
   if (r.has("target")) c.target = r.vec3("target", c.target), c.has_target = true;
   c.azimuth_deg = r.real("azimuth", c.azimuth_deg);
   c.elevation_deg = r.real("elevation", c.elevation_deg, -89.0, 89.0);
-  c.distance = r.real("distance", c.distance, 0.0);
+  c.distance = r.real("distance", c.distance, 0.0, Reader::kMaxMagnitude);
   c.fov_deg = r.real("fov", c.fov_deg, 0.1, 169.0);
   c.orthographic = r.boolean("orthographic", c.orthographic);
-  c.ortho_height = r.real("ortho_height", c.ortho_height, 0.0);
-  c.gltf_node = r.integer("gltf_node", c.gltf_node, -1);
+  c.ortho_height = r.real("ortho_height", c.ortho_height, 0.0, Reader::kMaxMagnitude);
+  c.gltf_node = r.integer("gltf_node", c.gltf_node, -1, INT32_MAX);
   if (c.mode == scene::CameraSpec::Mode::kGltf && c.gltf_node < 0)
     throw Error(r.key_path("gltf_node"), "is required with mode = \"gltf\"");
   c.orbit_deg = r.real("orbit", c.orbit_deg);
@@ -304,23 +324,30 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     const toml::node* n = r.node("frames");
     const toml::array* a = n->as_array();
     if (!a) r.type_error("frames", *n, "[first, last]");
-    std::vector<int> f;
-    for (const toml::node& e : *a) {
-      auto i = e.value_exact<int64_t>();
-      if (!i)
-        throw Error(r.key_path("frames"), fmt::format("expected integers, found {}", type_name(e)));
-      f.push_back(int(*i));
-    }
-    if (f.size() != 2)
+    if (a->size() != 2)
       throw Error(r.key_path("frames"), fmt::format("expected [first, last], got {} value{}",
-                                                    f.size(), f.size() == 1 ? "" : "s"));
-    if (f[0] < 0)
-      throw Error(r.key_path("frames"), fmt::format("frames must be >= 0, got {}", f[0]));
+                                                    a->size(), a->size() == 1 ? "" : "s"));
+    // Checked as int64 before narrowing: 4294967297 must not quietly become 1.
+    int64_t f[2];
+    for (int k = 0; k < 2; ++k) {
+      auto i = (*a)[k].value_exact<int64_t>();
+      if (!i)
+        throw Error(r.key_path("frames"),
+                    fmt::format("expected integers, found {}", type_name((*a)[k])));
+      if (*i < 0 || *i > kMaxFrame)
+        throw Error(r.key_path("frames"),
+                    fmt::format("frames must be in [0, {}], got {}", kMaxFrame, *i));
+      f[k] = *i;
+    }
     if (f[1] < f[0])
       throw Error(r.key_path("frames"),
                   fmt::format("the range [{}, {}] is reversed (last before first)", f[0], f[1]));
-    s.first_frame = f[0];
-    s.last_frame = f[1];
+    if (f[1] - f[0] + 1 > kMaxFrameCount)
+      throw Error(r.key_path("frames"),
+                  fmt::format("[{}, {}] is {} frames; a shot holds at most {}", f[0], f[1],
+                              f[1] - f[0] + 1, kMaxFrameCount));
+    s.first_frame = int(f[0]);
+    s.last_frame = int(f[1]);
   }
   s.fps = r.real("fps", s.fps, 1.0, 240.0);
   if (has_scene) {
@@ -334,8 +361,9 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
                     fmt::format("width and height must be integers in [1, 16384], got {}", v));
     s.width = int(size[0]);
     s.height = int(size[1]);
+    check_pixel_budget(r.key_path("size"), s.width, s.height);
     s.shot.clip = r.string("clip", "");
-    s.shot.start_time = r.real("start", 0.0f, 0.0);
+    s.shot.start_time = r.real("start", 0.0f, 0.0, 1e7);
     s.shot.loop = r.boolean("loop", false);
     s.shot.fps = s.fps;
     s.shot.first_frame = s.first_frame;
@@ -363,7 +391,7 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     if (const toml::table* t = r.table("ground")) {
       Reader g(*t, r.key_path("ground"), {"enabled", "size", "height", "color"});
       s.shot.ground.enabled = g.boolean("enabled", true);
-      s.shot.ground.size = g.real("size", 0.0f, 0.0);
+      s.shot.ground.size = g.real("size", 0.0f, 0.0, Reader::kMaxMagnitude);
       if (g.has("height"))
         s.shot.ground.height = g.real("height", 0.0f), s.shot.ground.auto_height = false;
       const composite::Color c = g.color("color", {0.8f, 0.8f, 0.8f});
@@ -418,17 +446,18 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
     std::error_code ec;
     if (!fs::is_regular_file(first, ec))
       throw Error(r.key_path("sequence"),
-                  fmt::format("no such file '{}' (frame {})", first, s.first_frame));
+                  fmt::format("no such file '{}' (frame {})", echo(first), s.first_frame));
     const std::vector<std::string> have = list_channels(first);
     auto has = [&](const std::string& ch) {
       return std::find(have.begin(), have.end(), ch) != have.end();
     };
     auto missing = [&](const std::string& key, const std::string& ch, const std::string& what) {
       std::string list;
-      for (std::size_t i = 0; i < have.size() && i < 64; ++i) list += (i ? ", " : "") + have[i];
+      for (std::size_t i = 0; i < have.size() && i < 64; ++i)
+        list += (i ? ", " : "") + echo(have[i], 40);
       if (have.size() > 64) list += fmt::format(", ... ({} more)", have.size() - 64);
-      throw Error(key, fmt::format("channel '{}' ({}) is not in '{}', which has: {}", ch, what,
-                                   first, list.empty() ? "no channels" : list));
+      throw Error(key, fmt::format("channel '{}' ({}) is not in '{}', which has: {}", echo(ch),
+                                   what, echo(first), list.empty() ? "no channels" : list));
     };
     for (const auto& cm : s.channels)
       for (const std::string& ch : cm.channels)
@@ -438,7 +467,8 @@ void parse_source(Reader& r, Context& ctx, pipeline::Source& s) {
       for (const std::string& ch : blender_channels(s.view_layer))
         if (!has(ch))
           missing(r.key_path("preset"), ch,
-                  fmt::format("a pass preset 'blender' reads from view layer '{}'", s.view_layer));
+                  fmt::format("a pass preset 'blender' reads from view layer '{}'",
+                              echo(s.view_layer)));
       alpha_channel = s.view_layer + ".Combined.A";
     } else {
       for (const render::PassInfo& p : render::pass_table()) {
@@ -550,7 +580,7 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
     const std::string near = closest_key(l.exemplar, names);
     throw Error(
         r.key_path("exemplar"),
-        fmt::format("'{}' is not defined in [exemplars]{}", l.exemplar,
+        fmt::format("'{}' is not defined in [exemplars]{}", echo(l.exemplar),
                     near.empty() ? (names.empty() ? std::string(" (there are none)")
                                                   : fmt::format(" (defined: {})", join(names)))
                                  : fmt::format(" — did you mean '{}'?", near)));
@@ -561,10 +591,11 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
     Reader g(*t, r.key_path("guides"), passes);
     l.guides.clear();
     // Guides keep the file's order so that results do not depend on how toml++ sorts keys.
-    std::vector<std::pair<std::string, int>> order;
+    // (line, column): as int64, since a 1 MB file may hold a million lines.
+    std::vector<std::pair<std::string, int64_t>> order;
     for (const auto& [k, v] : *t)
-      order.emplace_back(std::string(k.str()),
-                         int(v.source().begin.line) * 10000 + int(v.source().begin.column));
+      order.emplace_back(std::string(k.str()), int64_t(v.source().begin.line) * 100000000 +
+                                                   int64_t(v.source().begin.column));
     std::stable_sort(order.begin(), order.end(),
                      [](auto& a, auto& b) { return a.second < b.second; });
     for (const auto& [pass, line] : order) {
@@ -587,7 +618,7 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
     throw Error(r.key_path("pyramid_levels"), "must be >= 1, or -1 for automatic");
   s.search_vote_iters = r.integer("search_vote_iters", s.search_vote_iters, -1, 100);
   s.patch_match_iters = r.integer("patch_match_iters", s.patch_match_iters, -1, 100);
-  s.seed = uint64_t(r.integer("seed", 1, 0));
+  s.seed = uint64_t(r.integer("seed", 1, 0, INT32_MAX));
   l.single_colour = r.boolean("single_colour", true);
   const std::string channel = r.choice("channel", "luminance", {"luminance", "r", "g", "b"});
   l.channel = channel == "luminance" ? -1 : channel == "r" ? 0 : channel == "g" ? 1 : 2;
@@ -645,7 +676,7 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
       if (!sa || v.size() != 4 || sa->size() != 4)
         throw Error(r.key_path("gradient"), fmt::format("expected {}", expected));
       for (float x : v)
-        if (x < 0.0f || x > 1.0f)
+        if (!(x >= 0.0f && x <= 1.0f))
           throw Error(r.key_path("gradient"), fmt::format("values must be in [0, 1], got {}", x));
       if (!look.gradient.empty() && v[0] < look.gradient.back().position)
         throw Error(r.key_path("gradient"), "stops must be sorted by position");
@@ -682,7 +713,7 @@ void parse_layer(Reader& r, const Shot& shot, pipeline::Layer& l) {
   if (r.has("output_levels")) {
     const std::vector<float> v = r.numbers("output_levels", 2);
     for (float x : v)
-      if (x < 0.0f || x > 1.0f)
+      if (!(x >= 0.0f && x <= 1.0f))
         throw Error(r.key_path("output_levels"),
                     fmt::format("values must be in [0, 1], got {}", x));
     f.out_black = v[0], f.out_white = v[1];
@@ -698,9 +729,9 @@ void check_output_folder(const std::string& key, const std::string& folder) {
   fs::path p(folder);
   if (fs::exists(p, ec)) {
     if (!fs::is_directory(p, ec))
-      throw Error(key, fmt::format("'{}' exists and is not a folder", folder));
+      throw Error(key, fmt::format("'{}' exists and is not a folder", echo(folder)));
     if (::access(p.c_str(), W_OK | X_OK) != 0)
-      throw Error(key, fmt::format("folder '{}' is not writable", folder));
+      throw Error(key, fmt::format("folder '{}' is not writable", echo(folder)));
     return;
   }
   // Not there yet: the nearest existing parent must let us create it.
@@ -708,17 +739,93 @@ void check_output_folder(const std::string& key, const std::string& folder) {
   while (!parent.empty() && !fs::exists(parent, ec)) parent = parent.parent_path();
   if (parent.empty()) parent = ".";
   if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK | X_OK) != 0)
-    throw Error(key, fmt::format("cannot create folder '{}': '{}' is not a writable folder", folder,
-                                 parent.string()));
+    throw Error(key, fmt::format("cannot create folder '{}': '{}' is not a writable folder",
+                                 echo(folder), echo(parent.string())));
 }
 
 int declared_line(const toml::node& n) {
   return int(n.source().begin.line);
 }
 
+// toml++ recurses once per level of dotted key, table header, inline table and array (and so
+// does destroying the tree): a 400 KB file of `a.a.a...= 1` overflows the stack. This cheap
+// scan bounds the depth first. Depth here is 1 + open [ and { + the dots of the key being read;
+// strings and comments are skipped, and the dot count restarts at every = , newline or bracket,
+// so the dot of a float (1.5) adds one level at most.
+void check_nesting(std::string_view text, const std::string& path) {
+  int brackets = 0, dots = 0, line = 1;
+  auto too_deep = [&] {
+    throw Error(path, fmt::format("line {}: nested deeper than {} levels (tables, arrays, inline "
+                                  "tables or dotted keys)",
+                                  line, kMaxShotDepth));
+  };
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    switch (c) {
+      case '\n':
+        ++line;
+        dots = 0;
+        break;
+      case '#':
+        while (i + 1 < n && text[i + 1] != '\n') ++i;
+        break;
+      case '"':
+      case '\'': {
+        const bool basic = c == '"';
+        const bool multi = i + 2 < n && text[i + 1] == c && text[i + 2] == c;
+        i += multi ? 3 : 1;
+        for (; i < n; ++i) {
+          if (text[i] == '\n') {
+            ++line;
+            if (!multi) break;  // unterminated: toml++ reports it
+          }
+          if (basic && text[i] == '\\') {
+            if (i + 1 < n && text[i + 1] == '\n') ++line;
+            ++i;
+            continue;
+          }
+          if (text[i] != c) continue;
+          if (!multi) break;
+          if (i + 2 < n && text[i + 1] == c && text[i + 2] == c) {
+            // Up to two more quotes may close a multi-line string ("""a"""").
+            i += 2;
+            while (i + 1 < n && text[i + 1] == c) ++i;
+            break;
+          }
+        }
+        break;
+      }
+      case '[':
+      case '{':
+        if (++brackets + dots + 1 > kMaxShotDepth) too_deep();
+        dots = 0;
+        break;
+      case ']':
+      case '}':
+        brackets = std::max(0, brackets - 1);
+        dots = 0;
+        break;
+      case '=':
+      case ',':
+        dots = 0;
+        break;
+      case '.':
+        if (brackets + ++dots + 1 > kMaxShotDepth) too_deep();
+        break;
+      default:
+        break;
+    }
+  }
+}
+
 }  // namespace
 
 Shot parse_shot(std::string_view text, const std::string& path) {
+  if (text.size() > kMaxShotBytes)
+    throw Error(path, fmt::format("is {} bytes; a shot file may hold at most {}", text.size(),
+                                  kMaxShotBytes));
+  check_nesting(text, path);
   toml::table root;
   try {
     root = toml::parse(text, std::string_view(path));
@@ -729,8 +836,16 @@ Shot parse_shot(std::string_view text, const std::string& path) {
   Shot shot;
   shot.path = path;
   Context ctx{fs::path(path).parent_path()};
-  Reader top(root, "", {"source", "exemplars", "layers", "compositing", "outputs", "threads"});
+  Reader top(root, "",
+             {"source", "exemplars", "layers", "compositing", "outputs", "threads", "limits"});
   shot.threads = top.integer("threads", 0, 0, 1024);
+  // First: the budget applies to source.size and to the sequence's first frame read below.
+  if (const toml::table* t = top.table("limits")) {
+    Reader r(*t, "limits", {"max_pixels"});
+    if (r.has("max_pixels")) {
+      set_max_pixels_from_file(r.integer64("max_pixels", 0, 1, int64_t(1) << 40));
+    }
+  }
 
   {
     Reader src(*top.table("source", true), "source",
@@ -749,7 +864,7 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     std::sort(names.begin(), names.end());
     for (const auto& [line, name] : names) {
       const toml::node* n = exemplars->get(name);
-      const std::string key = "exemplars." + name;
+      const std::string key = "exemplars." + echo(name);
       if (!n->is_table()) throw Error(key, fmt::format("expected a table, got {}", type_name(*n)));
       Reader r(*n->as_table(), key,
                {"kind", "painting", "sphere", "elevation", "horizon", "fov", "light", "softness",
@@ -770,7 +885,7 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     std::sort(names.begin(), names.end());
     for (const auto& [line, name] : names) {
       const toml::node* n = layers->get(name);
-      const std::string key = "layers." + name;
+      const std::string key = "layers." + echo(name);
       if (!n->is_table()) throw Error(key, fmt::format("expected a table, got {}", type_name(*n)));
       for (char c : name)
         if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'))
@@ -849,9 +964,15 @@ Shot parse_shot(std::string_view text, const std::string& path) {
 Shot load_shot(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot open the shot file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_shot(ss.str(), path);
+  // Read at most one byte past the cap: a huge file (or /dev/zero) is refused without reading it.
+  std::string text(kMaxShotBytes + 1, '\0');
+  in.read(text.data(), std::streamsize(text.size()));
+  if (in.bad()) throw Error(path, "cannot read the shot file");
+  text.resize(std::size_t(in.gcount()));
+  if (text.size() > kMaxShotBytes)
+    throw Error(
+        path, fmt::format("is larger than {} bytes, the most a shot file may hold", kMaxShotBytes));
+  return parse_shot(text, path);
 }
 
 }  // namespace emaki::io

@@ -4,6 +4,7 @@
 // 'weight'?"). Relative paths are resolved against the shot file's folder.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -12,8 +13,15 @@
 
 namespace emaki::io {
 
+// A shot file is a page of text: larger files and deeper nesting are refused before toml++
+// parses them (its parser recurses per level; see docs/shot_file.md, "Limits").
+inline constexpr std::size_t kMaxShotBytes = 1 << 20;
+inline constexpr int kMaxShotDepth = 64;
+
 // Parses and checks a shot file: syntax, keys, types, ranges, references between sections,
 // input files that must exist, and that the output folder can be written. Throws emaki::Error.
+// A `limits.max_pixels` in the file sets the process's pixel budget unless the command line
+// pinned one (--max-pixels).
 pipeline::Shot load_shot(const std::string& path);
 
 // The same from text (`path` is used for messages and to resolve relative paths).

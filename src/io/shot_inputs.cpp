@@ -12,6 +12,7 @@
 #include <initializer_list>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
 #include "io/shot_manifest.h"
@@ -33,8 +34,14 @@ std::string frame_file(const std::string& pattern, int frame) {
     }
     std::size_t j = i + 1;
     int width = 0;
-    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j])))
+    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j]))) {
       width = width * 10 + (pattern[j++] - '0');
+      // Checked per digit, so the width never overflows an int either.
+      if (width > kMaxFrameWidth)
+        throw Error("source.sequence",
+                    fmt::format("'{}': the frame number's width must be at most {}", echo(pattern),
+                                kMaxFrameWidth));
+    }
     out += fmt::format("{:0{}d}", frame, width);
     i = j;  // at the 'd'
   }

@@ -17,7 +17,11 @@
 
 namespace emaki::io {
 
-// The file of frame `frame` of a printf-style pattern ("frame_%04d.exr").
+// The widest frame number a pattern may ask for (%012d): wider is refused, never padded.
+inline constexpr int kMaxFrameWidth = 12;
+
+// The file of frame `frame` of a printf-style pattern ("frame_%04d.exr"); the pattern holds %d
+// or %0Nd only (the shot file checks it), and a width over kMaxFrameWidth throws.
 std::string frame_file(const std::string& pattern, int frame);
 
 // The channel names a sequence source reads for `pass` (its mapping, or emaki's own names).

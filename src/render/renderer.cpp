@@ -6,8 +6,10 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <vector>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "render/raster.h"
 
@@ -23,6 +25,8 @@ constexpr int kGroundMaterial = 1;
 constexpr int kFirstSceneId = 2;
 // 8K at 3x3 samples per pixel; more would need gigabytes more of sample buffers.
 constexpr double kMaxSamples = 7680.0 * 4320.0 * 9.0;
+// Frames whose poses bound the shot (see the ShotRenderer constructor).
+constexpr int64_t kMaxBoundsFrames = 4096;
 
 Bounds cube_around(const Bounds& b) {
   if (b.empty()) return {glm::vec3(-1.0f), glm::vec3(1.0f)};
@@ -456,49 +460,81 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
                                     "buffers (limit {:.1f} GB); lower --aa or --size",
                                     options_.width, options_.height, options_.aa, options_.aa,
                                     samples * 16 / 1e9, kMaxSamples * 16 / 1e9));
-  if (!(shot_.fps > 0.0f)) throw Error("--fps", fmt::format("must be > 0, got {}", shot_.fps));
+  // Front ends check these with their own names; this is the last line for any other caller.
+  if (!(shot_.fps >= kMinFps && shot_.fps <= kMaxFps))
+    throw Error("--fps", fmt::format("must be in [{}, {}], got {}", kMinFps, kMaxFps, shot_.fps));
+  if (!std::isfinite(shot_.start_time) || shot_.start_time < 0.0f)
+    throw Error("--start", fmt::format("must be a finite number >= 0, got {}", shot_.start_time));
   if (!shot_.clip.empty()) {
     animation_ = scene.find_animation(shot_.clip);
     if (animation_ < 0) {
+      // Names come from the scene and the command line: each is echoed capped, and few.
       std::string names;
-      for (const auto& a : scene.animations) names += (names.empty() ? "'" : ", '") + a.name + "'";
-      throw Error("--clip", fmt::format("no clip '{}' in the scene (clips: {})", shot_.clip,
+      for (std::size_t i = 0; i < scene.animations.size() && i < 16; ++i)
+        names += (names.empty() ? "'" : ", '") + echo(scene.animations[i].name, 40) + "'";
+      if (scene.animations.size() > 16)
+        names += fmt::format(", ... ({} more)", scene.animations.size() - 16);
+      throw Error("--clip", fmt::format("no clip '{}' in the scene (clips: {})", echo(shot_.clip),
                                         names.empty() ? "none" : names));
     }
   } else if (!scene.animations.empty()) {
     animation_ = 0;
   }
-  if (shot_.first_frame < 0 || shot_.last_frame < shot_.first_frame)
+  // Bounded before any loop over the range: f - 1, (first + last) / 2 and the loops below then
+  // never overflow, and --frames 2147483647 --loop is refused instead of spinning forever.
+  if (shot_.first_frame < 0 || shot_.last_frame < shot_.first_frame ||
+      shot_.last_frame > kMaxFrame || shot_.last_frame - shot_.first_frame >= kMaxFrameCount)
     throw Error("--frames",
-                fmt::format("invalid frame range {}-{}", shot_.first_frame, shot_.last_frame));
+                fmt::format("invalid frame range {}-{} (frames in [0, {}], at most {} of them)",
+                            shot_.first_frame, shot_.last_frame, kMaxFrame, kMaxFrameCount));
   if (animation_ >= 0) {
     const scene::Animation& a = scene.animations[animation_];
     const float duration = a.end - a.start;
-    if (shot_.start_time < 0.0f || shot_.start_time > duration)
+    if (!std::isfinite(duration))
+      throw Error("--clip", fmt::format("clip '{}' has no finite length", echo(a.name)));
+    if (shot_.start_time > duration)
       throw Error("--start", fmt::format("{} s is outside clip '{}' ({:.3f} s long)",
-                                         shot_.start_time, a.name, duration));
-    const int last_frame = int(std::floor((duration - shot_.start_time) * shot_.fps + 1e-3f));
+                                         shot_.start_time, echo(a.name), duration));
+    // In double and clamped: a clip of 1e30 s must not overflow the int.
+    const double frames_in_clip =
+        std::floor((double(duration) - shot_.start_time) * shot_.fps + 1e-3);
+    const int last_frame = int(std::min<double>(frames_in_clip, kMaxFrame));
     if (!shot_.loop && shot_.last_frame > last_frame)
       throw Error("--frames",
                   fmt::format("frame {} is at {:.3f} s, past the end of clip '{}' "
                               "({:.3f} s long: frames 0-{} at {} fps from {} s; --loop plays it "
                               "in a loop)",
                               shot_.last_frame, shot_.start_time + shot_.last_frame / shot_.fps,
-                              a.name, duration, last_frame, shot_.fps, shot_.start_time));
+                              echo(a.name), duration, last_frame, shot_.fps, shot_.start_time));
   }
   if (shot_.camera.mode == scene::CameraSpec::Mode::kGltf) {
     const int n = shot_.camera.gltf_node;
     if (n < 0 || n >= int(scene.nodes.size()) || scene.nodes[n].camera < 0)
       throw Error("--gltf-camera", fmt::format("node {} is not a camera node", n));
   }
-  // The boxes are fixed for the shot, so normalised values compare across frames.
-  for (int f = shot_.first_frame; f <= shot_.last_frame; ++f) {
-    const scene::PosedScene posed = scene::pose_scene(scene, animation_, time_of(f));
+  // The boxes are fixed for the shot, so normalised values compare across frames. They come
+  // from every frame of a range up to kMaxBoundsFrames long (so results do not change for any
+  // ordinary shot) and from kMaxBoundsFrames evenly spread frames of a longer one: the work
+  // before the first frame renders must not grow with a million-frame range.
+  const int first = shot_.first_frame, last = shot_.last_frame;
+  const int mid = first + (last - first) / 2;
+  const int64_t count = int64_t(last) - first + 1;
+  std::vector<int> frames;
+  if (count <= kMaxBoundsFrames) {
+    for (int f = first; f <= last; ++f) frames.push_back(f);
+  } else {
+    for (int64_t k = 0; k < kMaxBoundsFrames; ++k)
+      frames.push_back(int(first + (count - 1) * k / (kMaxBoundsFrames - 1)));
+    frames.push_back(mid);  // the middle pose frames the camera below
+    std::sort(frames.begin(), frames.end());
+    frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  }
+  for (const int f : frames) {
+    const scene::PosedScene posed = scene::pose_scene(scene, animation_, time_of(float(f)));
     shot_bounds_.add(scene::world_bounds(posed));
-    if (f == shot_.first_frame) rest_box_ = cube_around(scene::rest_bounds(posed));
+    if (f == first) rest_box_ = cube_around(scene::rest_bounds(posed));
     // A few poses' vertices (first, middle, last frame; at most ~20k points) for framing.
-    const int mid = (shot_.first_frame + shot_.last_frame) / 2;
-    if (f == shot_.first_frame || f == mid || f == shot_.last_frame) {
+    if (f == first || f == mid || f == last) {
       std::size_t total = 0;
       for (const auto& p : posed.primitives) total += p.world_positions.size();
       const std::size_t step = std::max<std::size_t>(1, total / 20000);

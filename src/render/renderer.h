@@ -13,6 +13,10 @@
 
 namespace emaki::render {
 
+// Frame rates a shot may play at (`--fps`); outside them frame times lose all precision.
+inline constexpr float kMinFps = 0.01f;
+inline constexpr float kMaxFps = 1000.0f;
+
 struct RenderOptions {
   int width = 640;             // pixels, [1, 16384]
   int height = 360;            // pixels, [1, 16384]
