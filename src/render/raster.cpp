@@ -90,8 +90,15 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
                               &vertices[indices[3 * t + 2]]};
     bool inside = true, all_out = false;
     {
-      // Trivial accept / reject against the near plane and the guard band.
+      // Trivial accept / reject against the near plane and the guard band. A NaN or infinite
+      // coordinate (a degenerate camera, an overflowing transform) drops the triangle: every
+      // comparison below would pass it through to the integer snapping.
       int near_out = 0;
+      bool finite = true;
+      for (int k = 0; k < 3; ++k)
+        finite = finite && std::isfinite(v[k]->x) && std::isfinite(v[k]->y) &&
+                 std::isfinite(v[k]->w) && std::isfinite(v[k]->depth);
+      if (!finite) continue;
       for (int k = 0; k < 3; ++k) {
         if (v[k]->depth < options.znear) ++near_out;
         if (v[k]->depth < options.znear || std::abs(v[k]->x) > kGuard * v[k]->w ||
@@ -124,15 +131,27 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
     };
     P pv[9];
     const int n = std::min<int>(int(poly.size()), 9);
+    // Clipped to the guard band, projected points lie within a few frame widths of the frame;
+    // one outside that (float error on huge inputs, a NaN from clipping between extreme
+    // points) drops the polygon before it is snapped to integers and the edge products
+    // could overflow.
+    const double limit = (double(kGuard) + 2.0) * double(std::max(W, H)) + 1.0;
+    bool in_range = true;
     for (int k = 0; k < n; ++k) {
       const glm::vec4& c = poly[k].c;
       const float inv_w = 1.0f / c.z;
       const float px = (c.x * inv_w + 1.0f) * sx;
       const float py = (1.0f - c.y * inv_w) * sy;
+      if (!(std::abs(double(px)) <= limit && std::abs(double(py)) <= limit) ||
+          !std::isfinite(inv_w) || !std::isfinite(c.w)) {
+        in_range = false;
+        break;
+      }
       pv[k] = {int64_t(std::llround(double(px) * sub)), int64_t(std::llround(double(py) * sub)),
                options.perspective ? 1.0f / c.w : -c.w, options.perspective ? inv_w : 1.0f,
                poly[k].bary};
     }
+    if (!in_range) continue;
     for (int k = 1; k + 1 < n; ++k) {
       ScreenTri st;
       const P* q[3] = {&pv[0], &pv[k], &pv[k + 1]};
