@@ -602,7 +602,7 @@ class Loader {
   // Adds n to a running total, failing once it passes `limit`.
   void charge(int64_t& total, uint64_t n, int64_t limit, const std::string& what) const {
     const auto sum = n <= uint64_t(limit) ? checked_add<int64_t>(total, int64_t(n)) : std::nullopt;
-    if (!sum || *sum > limit) fail(fmt::format("{}: more than {} in the file", what, limit));
+    if (!sum || *sum > limit) fail(fmt::format("{} (more than {})", what, limit));
     total = *sum;
   }
 
@@ -634,7 +634,7 @@ class Loader {
         scene::Primitive p;
         p.positions = read_vecs<glm::vec3>(attr("POSITION"), where + " POSITION");
         const std::size_t nv = p.positions.size();
-        charge(vertices_, nv, kMaxVertices, where + " vertices");
+        charge(vertices_, nv, kMaxVertices, where + " takes the file past its vertex limit");
         mesh_vertices_[mi] += int64_t(nv);
         auto check_count = [&](std::size_t n, const char* name) {
           if (n != nv)
@@ -693,7 +693,7 @@ class Loader {
         const std::size_t tris = mode == TINYGLTF_MODE_TRIANGLES
                                      ? idx.size() / 3
                                      : std::max<std::size_t>(idx.size(), 2) - 2;
-        charge(triangles_, tris, kMaxTriangles, where + " triangles");
+        charge(triangles_, tris, kMaxTriangles, where + " takes the file past its triangle limit");
         mesh_triangles_[mi] += int64_t(tris);
         p.indices = triangles(idx, mode);
         if (prim.material >= 0 && std::size_t(prim.material) >= m_.materials.size())
@@ -996,9 +996,9 @@ class Loader {
       const scene::Node& node = s.nodes[i];
       if (node.mesh >= 0) {
         charge(vertices, uint64_t(mesh_vertices_[node.mesh]), kMaxVertices,
-               "vertices drawn by the scene's nodes");
+               "the scene's nodes draw too many vertices, counting each instance of a mesh");
         charge(triangles, uint64_t(mesh_triangles_[node.mesh]), kMaxTriangles,
-               "triangles drawn by the scene's nodes");
+               "the scene's nodes draw too many triangles, counting each instance of a mesh");
       }
       stack.insert(stack.end(), node.children.begin(), node.children.end());
     }

@@ -24,12 +24,13 @@ inline constexpr int64_t kMaxJsonContainers = int64_t(1) << 21;
 inline constexpr int64_t kMaxFileBytes = int64_t(1) << 30;
 // Vertices (POSITION elements) and triangles over all mesh primitives of the file, and again
 // over every drawn instance of them (a mesh drawn by 1000 nodes counts 1000 times): what the
-// renderer holds per frame grows with these.
-inline constexpr int64_t kMaxVertices = int64_t(1) << 24;
-inline constexpr int64_t kMaxTriangles = int64_t(1) << 24;
+// renderer holds per frame grows with these (about 250 bytes a drawn vertex and 200 a drawn
+// triangle: 4M of each stays under 2 GB).
+inline constexpr int64_t kMaxVertices = int64_t(1) << 22;
+inline constexpr int64_t kMaxTriangles = int64_t(1) << 22;
 // Numbers (floats or integers) read from accessors over the whole file: attributes, indices,
-// morph targets, skins, animation keys. 2^27 is 512 MiB of floats.
-inline constexpr int64_t kMaxAccessorValues = int64_t(1) << 27;
+// morph targets, skins, animation keys. 2^26 is 256 MiB of floats.
+inline constexpr int64_t kMaxAccessorValues = int64_t(1) << 26;
 // Morph targets per primitive (and weights per key of a weights animation).
 inline constexpr int kMaxMorphTargets = 4096;
 // Joints per skin: JOINTS_0 holds 8- or 16-bit indices.
