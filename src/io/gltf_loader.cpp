@@ -359,7 +359,14 @@ class Loader {
   // Where an accessor's elements lie, checking with overflow-checked arithmetic that every byte
   // it touches is inside its buffer view and the view inside its buffer.
   Span locate(const tinygltf::Accessor& acc, int comps, int index, const std::string& what) const {
-    if (acc.bufferView < 0) return {};
+    if (acc.bufferView < 0) {
+      if (acc.count > uint64_t(kMaxZeroAccessorElements))
+        fail(
+            fmt::format("{} (accessor {}) has no buffer view: its {} elements would all be zero "
+                        "(at most {} allowed)",
+                        what, index, acc.count, kMaxZeroAccessorElements));
+      return {};
+    }
     if (std::size_t(acc.bufferView) >= m_.bufferViews.size())
       fail(fmt::format("{} (accessor {}) refers to buffer view {}, but the file has {}", what,
                        index, acc.bufferView, m_.bufferViews.size()));

@@ -31,6 +31,10 @@ inline constexpr int64_t kMaxTriangles = int64_t(1) << 22;
 // Numbers (floats or integers) read from accessors over the whole file: attributes, indices,
 // morph targets, skins, animation keys. 2^26 is 256 MiB of floats.
 inline constexpr int64_t kMaxAccessorValues = int64_t(1) << 26;
+// Elements of an accessor without a buffer view. Such an accessor is all zeros (its data would
+// come from sparse storage or an extension, neither of which is read), so a large one is only
+// a way for a tiny file to ask for millions of vertices.
+inline constexpr int64_t kMaxZeroAccessorElements = 65536;
 // Morph targets per primitive (and weights per key of a weights animation).
 inline constexpr int kMaxMorphTargets = 4096;
 // Joints per skin: JOINTS_0 holds 8- or 16-bit indices.
