@@ -106,6 +106,8 @@ const Case kCases[] = {
     {"view_offset_wrap.gltf",
      "buffer view 0 (offset 18446744073709551600, length 36) is out of range"},
     {"accessor_offset_wrap.gltf", "is out of range"},
+    // Found by the gltf fuzzer: a count of 0 skipped the range check (UBSan: pointer overflow).
+    {"fuzz_empty_accessor_offset.gltf", "0 elements of 12 bytes from offset 18446744073709551612"},
     {"stride_too_small.gltf", "byteStride 4"},
     {"index_out_of_range.gltf", "has index 7 but only 3 vertices"},
     {"zero_accessor_huge.gltf", "more than 67108864 values"},

@@ -387,7 +387,8 @@ class Loader {
           "buffer view {} (offset {}, length {}) is out of range of buffer {}, "
           "which has {} bytes",
           acc.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.data.size()));
-    std::optional<uint64_t> need = uint64_t(0);
+    // Even an empty accessor's offset must lie in its view: the data pointer is formed from it.
+    std::optional<uint64_t> need = uint64_t(acc.byteOffset);
     if (acc.count > 0) {
       const auto span = checked_mul<uint64_t>(stride, acc.count - 1);
       need = span ? checked_add<uint64_t>(*span, elem) : std::nullopt;
