@@ -105,6 +105,9 @@ int run_render(const Args& args) {
                "also write DIR/preview/frame_NNNN_<pass>.png for every pass");
   app.add_flag("--float", full_float, "32-bit float EXR channels (default: half)");
   app.add_flag("--quiet", quiet, "no progress on stderr");
+  io::GltfOptions gltf_options;
+  app.add_flag("--allow-outside-paths", gltf_options.allow_outside_paths,
+               "let the scene read buffers and images outside its own folder");
   if (parse_cli(app, args)) return 0;
 
   scene::ShotSpec shot;
@@ -118,7 +121,7 @@ int run_render(const Args& args) {
   shot.clip = clip;
   shot.loop = loop;
 
-  const scene::Scene scene = io::load_gltf(scene_path);
+  const scene::Scene scene = io::load_gltf(scene_path, gltf_options);
   const render::ShotRenderer renderer(scene, shot, options);
   const fs::path dir(out_dir);
   make_dir("--out", dir);

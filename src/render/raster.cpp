@@ -90,8 +90,15 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
                               &vertices[indices[3 * t + 2]]};
     bool inside = true, all_out = false;
     {
-      // Trivial accept / reject against the near plane and the guard band.
+      // Trivial accept / reject against the near plane and the guard band. A NaN or infinite
+      // coordinate (a degenerate camera, an overflowing transform) drops the triangle: every
+      // comparison below would pass it through to the integer snapping.
       int near_out = 0;
+      bool finite = true;
+      for (int k = 0; k < 3; ++k)
+        finite = finite && std::isfinite(v[k]->x) && std::isfinite(v[k]->y) &&
+                 std::isfinite(v[k]->w) && std::isfinite(v[k]->depth);
+      if (!finite) continue;
       for (int k = 0; k < 3; ++k) {
         if (v[k]->depth < options.znear) ++near_out;
         if (v[k]->depth < options.znear || std::abs(v[k]->x) > kGuard * v[k]->w ||
@@ -124,15 +131,27 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
     };
     P pv[9];
     const int n = std::min<int>(int(poly.size()), 9);
+    // Clipped to the guard band, projected points lie within a few frame widths of the frame;
+    // one outside that (float error on huge inputs, a NaN from clipping between extreme
+    // points) drops the polygon before it is snapped to integers and the edge products
+    // could overflow.
+    const double limit = (double(kGuard) + 2.0) * double(std::max(W, H)) + 1.0;
+    bool in_range = true;
     for (int k = 0; k < n; ++k) {
       const glm::vec4& c = poly[k].c;
       const float inv_w = 1.0f / c.z;
       const float px = (c.x * inv_w + 1.0f) * sx;
       const float py = (1.0f - c.y * inv_w) * sy;
+      if (!(std::abs(double(px)) <= limit && std::abs(double(py)) <= limit) ||
+          !std::isfinite(inv_w) || !std::isfinite(c.w)) {
+        in_range = false;
+        break;
+      }
       pv[k] = {int64_t(std::llround(double(px) * sub)), int64_t(std::llround(double(py) * sub)),
                options.perspective ? 1.0f / c.w : -c.w, options.perspective ? inv_w : 1.0f,
                poly[k].bary};
     }
+    if (!in_range) continue;
     for (int k = 1; k + 1 < n; ++k) {
       ScreenTri st;
       const P* q[3] = {&pv[0], &pv[k], &pv[k + 1]};
@@ -162,70 +181,81 @@ void rasterize(const std::vector<ClipVertex>& vertices, const std::vector<uint32
     }
   }
 
-  // Bin by tile.
+  // Bin by tile, in passes of at most kMaxBinEntries entries: many large triangles would
+  // otherwise need (triangles x tiles they cover) entries at once (gigabytes for a file of a
+  // million frame-filling triangles). Passes run in triangle order, so the result is the same.
+  constexpr std::size_t kMaxBinEntries = std::size_t(1) << 24;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   std::vector<std::vector<int32_t>> bins(std::size_t(tiles_x) * tiles_y);
-  for (int32_t i = 0; i < int32_t(tris.size()); ++i) {
-    const ScreenTri& st = tris[i];
-    for (int ty = st.y0 / kTile; ty <= st.y1 / kTile; ++ty)
-      for (int tx = st.x0 / kTile; tx <= st.x1 / kTile; ++tx) bins[ty * tiles_x + tx].push_back(i);
-  }
-
   const bool attrs = options.with_attributes;
-  parallel_for(int64_t(bins.size()), 1, [&](int64_t b0, int64_t b1) {
-    for (int64_t b = b0; b < b1; ++b) {
-      const int tx = int(b % tiles_x), ty = int(b / tiles_x);
-      const int tx0 = tx * kTile, ty0 = ty * kTile;
-      const int tx1 = std::min(W, tx0 + kTile) - 1, ty1 = std::min(H, ty0 + kTile) - 1;
-      for (int32_t i : bins[b]) {
-        const ScreenTri& st = tris[i];
-        const int x0 = std::max(st.x0, tx0), x1 = std::min(st.x1, tx1);
-        const int y0 = std::max(st.y0, ty0), y1 = std::min(st.y1, ty1);
-        if (x0 > x1 || y0 > y1) continue;
-        // Edge e runs from vertex (e+1)%3 to (e+2)%3 and weighs vertex e.
-        int64_t ex[3], ey[3], e_row[3], bias[3];
-        const int64_t px0 = (int64_t(x0) << kSubBits) + (1 << (kSubBits - 1));
-        const int64_t py0 = (int64_t(y0) << kSubBits) + (1 << (kSubBits - 1));
-        for (int e = 0; e < 3; ++e) {
-          const int a = (e + 1) % 3, c = (e + 2) % 3;
-          const int64_t dx = st.x[c] - st.x[a], dy = st.y[c] - st.y[a];
-          // Tie rule: a sample exactly on an edge belongs to the one of the two triangles
-          // sharing it for which the edge runs "down" (or "left" when horizontal).
-          bias[e] = (dy > 0 || (dy == 0 && dx < 0)) ? 0 : -1;
-          ex[e] = -dy << kSubBits;  // change of the edge function per sample step in x
-          ey[e] = dx << kSubBits;
-          e_row[e] = dx * (py0 - st.y[a]) - dy * (px0 - st.x[a]);
-        }
-        const double inv_area = 1.0 / double((st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) -
-                                             (st.y[1] - st.y[0]) * (st.x[2] - st.x[0]));
-        for (int y = y0; y <= y1; ++y) {
-          int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
-          for (int x = x0; x <= x1; ++x) {
-            if ((e0 + bias[0]) >= 0 && (e1 + bias[1]) >= 0 && (e2 + bias[2]) >= 0) {
-              const float l0 = float(double(e0) * inv_area), l1 = float(double(e1) * inv_area);
-              const float l2 = 1.0f - l0 - l1;
-              const float key = l0 * st.key[0] + l1 * st.key[1] + l2 * st.key[2];
-              const std::size_t idx = out.index(x, y);
-              if (key > out.key[idx]) {
-                out.key[idx] = key;
-                out.tri[idx] = st.source;
-                if (attrs) {
-                  const float q0 = l0 * st.inv_w[0], q1 = l1 * st.inv_w[1], q2 = l2 * st.inv_w[2];
-                  const float s = 1.0f / (q0 + q1 + q2);
-                  const glm::vec3 bary =
-                      (q0 * s) * st.bary[0] + (q1 * s) * st.bary[1] + (q2 * s) * st.bary[2];
-                  out.b1[idx] = bary.y;
-                  out.b2[idx] = bary.z;
+  for (std::size_t first = 0, end = 0; first < tris.size(); first = end) {
+    for (auto& bin : bins) bin.clear();
+    std::size_t entries = 0;
+    for (end = first; end < tris.size(); ++end) {
+      const ScreenTri& st = tris[end];
+      const std::size_t n = std::size_t(st.y1 / kTile - st.y0 / kTile + 1) *
+                            std::size_t(st.x1 / kTile - st.x0 / kTile + 1);
+      if (end > first && entries + n > kMaxBinEntries) break;
+      entries += n;
+      for (int ty = st.y0 / kTile; ty <= st.y1 / kTile; ++ty)
+        for (int tx = st.x0 / kTile; tx <= st.x1 / kTile; ++tx)
+          bins[ty * tiles_x + tx].push_back(int32_t(end));
+    }
+    parallel_for(int64_t(bins.size()), 1, [&](int64_t b0, int64_t b1) {
+      for (int64_t b = b0; b < b1; ++b) {
+        const int tx = int(b % tiles_x), ty = int(b / tiles_x);
+        const int tx0 = tx * kTile, ty0 = ty * kTile;
+        const int tx1 = std::min(W, tx0 + kTile) - 1, ty1 = std::min(H, ty0 + kTile) - 1;
+        for (int32_t i : bins[b]) {
+          const ScreenTri& st = tris[i];
+          const int x0 = std::max(st.x0, tx0), x1 = std::min(st.x1, tx1);
+          const int y0 = std::max(st.y0, ty0), y1 = std::min(st.y1, ty1);
+          if (x0 > x1 || y0 > y1) continue;
+          // Edge e runs from vertex (e+1)%3 to (e+2)%3 and weighs vertex e.
+          int64_t ex[3], ey[3], e_row[3], bias[3];
+          const int64_t px0 = (int64_t(x0) << kSubBits) + (1 << (kSubBits - 1));
+          const int64_t py0 = (int64_t(y0) << kSubBits) + (1 << (kSubBits - 1));
+          for (int e = 0; e < 3; ++e) {
+            const int a = (e + 1) % 3, c = (e + 2) % 3;
+            const int64_t dx = st.x[c] - st.x[a], dy = st.y[c] - st.y[a];
+            // Tie rule: a sample exactly on an edge belongs to the one of the two triangles
+            // sharing it for which the edge runs "down" (or "left" when horizontal).
+            bias[e] = (dy > 0 || (dy == 0 && dx < 0)) ? 0 : -1;
+            ex[e] = -dy << kSubBits;  // change of the edge function per sample step in x
+            ey[e] = dx << kSubBits;
+            e_row[e] = dx * (py0 - st.y[a]) - dy * (px0 - st.x[a]);
+          }
+          const double inv_area = 1.0 / double((st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) -
+                                               (st.y[1] - st.y[0]) * (st.x[2] - st.x[0]));
+          for (int y = y0; y <= y1; ++y) {
+            int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
+            for (int x = x0; x <= x1; ++x) {
+              if ((e0 + bias[0]) >= 0 && (e1 + bias[1]) >= 0 && (e2 + bias[2]) >= 0) {
+                const float l0 = float(double(e0) * inv_area), l1 = float(double(e1) * inv_area);
+                const float l2 = 1.0f - l0 - l1;
+                const float key = l0 * st.key[0] + l1 * st.key[1] + l2 * st.key[2];
+                const std::size_t idx = out.index(x, y);
+                if (key > out.key[idx]) {
+                  out.key[idx] = key;
+                  out.tri[idx] = st.source;
+                  if (attrs) {
+                    const float q0 = l0 * st.inv_w[0], q1 = l1 * st.inv_w[1], q2 = l2 * st.inv_w[2];
+                    const float s = 1.0f / (q0 + q1 + q2);
+                    const glm::vec3 bary =
+                        (q0 * s) * st.bary[0] + (q1 * s) * st.bary[1] + (q2 * s) * st.bary[2];
+                    out.b1[idx] = bary.y;
+                    out.b2[idx] = bary.z;
+                  }
                 }
               }
+              e0 += ex[0], e1 += ex[1], e2 += ex[2];
             }
-            e0 += ex[0], e1 += ex[1], e2 += ex[2];
+            e_row[0] += ey[0], e_row[1] += ey[1], e_row[2] += ey[2];
           }
-          e_row[0] += ey[0], e_row[1] += ey[1], e_row[2] += ey[2];
         }
       }
-    }
-  });
+    });
+  }
 }
 
 }  // namespace emaki::render

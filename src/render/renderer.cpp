@@ -171,6 +171,9 @@ float wrap_coord(float u, scene::Texture::Wrap mode) {
 
 glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv) {
   const int w = t.rgba.width(), h = t.rgba.height();
+  // A non-finite uv (from a degenerate triangle's barycentrics) reads texel 0: converting it to
+  // int would be undefined.
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
   const float x = wrap_coord(uv.x, t.wrap_s) * w - 0.5f;
   const float y = wrap_coord(uv.y, t.wrap_t) * h - 0.5f;
   const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
@@ -267,6 +270,9 @@ class ShadowMap {
  private:
   // Depth of the nearest caster at a map position (infinity: none).
   float occluder(float u, float v) const {
+    // Range-checked as floats first: converting a NaN or huge float to int is undefined.
+    if (!(u >= 0.0f && v >= 0.0f && u < float(size_) && v < float(size_)))
+      return std::numeric_limits<float>::infinity();
     const int x = int(std::floor(u)), y = int(std::floor(v));
     if (x < 0 || y < 0 || x >= size_ || y >= size_) return std::numeric_limits<float>::infinity();
     const float key = map_.key[map_.index(x, y)];
@@ -276,6 +282,10 @@ class ShadowMap {
   Projector proj_;
   // The nearest occluder depth over the blocks touching a map rectangle.
   float nearest_in(float u0, float v0, float u1, float v1) const {
+    // Clamped as floats before the int conversion (NaN becomes 0).
+    const float hi = float(size_);
+    auto clampf = [hi](float f) { return f >= 0.0f ? std::min(f, hi) : 0.0f; };
+    u0 = clampf(u0), v0 = clampf(v0), u1 = clampf(u1), v1 = clampf(v1);
     const int bx0 = std::clamp(int(std::floor(u0)) / kBlock, 0, blocks_ - 1);
     const int by0 = std::clamp(int(std::floor(v0)) / kBlock, 0, blocks_ - 1);
     const int bx1 = std::clamp(int(std::floor(u1)) / kBlock, 0, blocks_ - 1);

@@ -1,10 +1,14 @@
 #include "scene/scene.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/check.h"
+#include "core/error.h"
+#include "core/limits.h"
 
 namespace emaki::scene {
 
@@ -122,13 +126,16 @@ Pose evaluate_pose(const Scene& scene, int animation, float t) {
       }
     }
   }
-  // Parents before children: walk down from every parentless node.
+  // Parents before children: walk down from every parentless node. The nodes form a forest (a
+  // loader invariant), so each is reached once; the count guards the invariant.
   std::vector<int> stack;
   for (int i = 0; i < n; ++i)
     if (scene.nodes[i].parent < 0) stack.push_back(i);
+  int visited = 0;
   while (!stack.empty()) {
     const int i = stack.back();
     stack.pop_back();
+    CHECK_LE(++visited, n);
     const Node& node = scene.nodes[i];
     glm::mat4 local;
     if (node.has_matrix) {
@@ -138,6 +145,13 @@ Pose evaluate_pose(const Scene& scene, int animation, float t) {
               glm::mat4_cast(pose.rotation[i]) * glm::scale(glm::mat4(1.0f), pose.scale[i]);
     }
     pose.world[i] = node.parent >= 0 ? pose.world[node.parent] * local : local;
+    for (int k = 0; k < 4; ++k)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(pose.world[i][k][r]))
+          throw Error(scene.source,
+                      fmt::format("node {} ('{}') has a non-finite world transform at {} s (its "
+                                  "transforms or animation values overflow)",
+                                  i, echo(node.name), t));
     for (int c : node.children) stack.push_back(c);
   }
   return pose;
@@ -170,8 +184,34 @@ void smooth_normals(const std::vector<glm::vec3>& p, const std::vector<uint32_t>
   for (auto& v : n) v = safe_normalize(v);
 }
 
-void pose_primitive(const Scene& scene, const Pose& pose, int node_index, const Primitive& prim,
-                    const std::vector<float>& morph_weights, PosedPrimitive& out) {
+// Joint matrices of each skin at one pose, computed on first use: a file may draw many
+// primitives with one skin of many joints.
+class JointMatrices {
+ public:
+  JointMatrices(const Scene& scene, const Pose& pose)
+      : scene_(scene), pose_(pose), cache_(scene.skins.size()), done_(scene.skins.size(), 0) {}
+  const std::vector<glm::mat4>& of(int skin_index) {
+    if (!done_[skin_index]) {
+      const Skin& skin = scene_.skins[skin_index];
+      std::vector<glm::mat4>& m = cache_[skin_index];
+      m.resize(skin.joints.size());
+      for (std::size_t j = 0; j < skin.joints.size(); ++j)
+        m[j] = pose_.world[skin.joints[j]] * skin.inverse_bind[j];
+      done_[skin_index] = 1;
+    }
+    return cache_[skin_index];
+  }
+
+ private:
+  const Scene& scene_;
+  const Pose& pose_;
+  std::vector<std::vector<glm::mat4>> cache_;
+  std::vector<char> done_;
+};
+
+void pose_primitive(const Scene& scene, const Pose& pose, JointMatrices& joints, int node_index,
+                    const Primitive& prim, const std::vector<float>& morph_weights,
+                    PosedPrimitive& out) {
   const Node& node = scene.nodes[node_index];
   const std::size_t nv = prim.positions.size();
   std::vector<glm::vec3> pos = prim.positions;
@@ -191,10 +231,7 @@ void pose_primitive(const Scene& scene, const Pose& pose, int node_index, const 
   const bool skinned = node.skin >= 0 && prim.joints.size() == nv && prim.weights.size() == nv;
   if (skinned) {
     // glTF: a skinned mesh ignores its own node's transform; joints carry it.
-    const Skin& skin = scene.skins[node.skin];
-    std::vector<glm::mat4> joint_matrix(skin.joints.size());
-    for (std::size_t j = 0; j < skin.joints.size(); ++j)
-      joint_matrix[j] = pose.world[skin.joints[j]] * skin.inverse_bind[j];
+    const std::vector<glm::mat4>& joint_matrix = joints.of(node.skin);
     for (std::size_t v = 0; v < nv; ++v) {
       glm::mat4 m(0.0f);
       const glm::vec4 w = prim.weights[v];
@@ -211,6 +248,16 @@ void pose_primitive(const Scene& scene, const Pose& pose, int node_index, const 
       if (has_normals) out.world_normals[v] = safe_normalize(nm * nrm[v]);
     }
   }
+  for (std::size_t v = 0; v < nv; ++v) {
+    const glm::vec3& p = out.world_positions[v];
+    // Written so that NaN fails too.
+    if (!(std::abs(p.x) <= kMaxWorldCoordinate && std::abs(p.y) <= kMaxWorldCoordinate &&
+          std::abs(p.z) <= kMaxWorldCoordinate))
+      throw Error(scene.source,
+                  fmt::format("node {} ('{}') poses vertex {} at ({}, {}, {}): posed positions "
+                              "must be finite and within ±{:g}",
+                              node_index, echo(node.name), v, p.x, p.y, p.z, kMaxWorldCoordinate));
+  }
   if (!has_normals) smooth_normals(out.world_positions, prim.indices, out.world_normals);
   out.rest_positions = &prim.positions;
   out.uvs = &prim.uvs;
@@ -222,6 +269,7 @@ void pose_primitive(const Scene& scene, const Pose& pose, int node_index, const 
 
 PosedScene pose_scene(const Scene& scene, int animation, float t) {
   const Pose pose = evaluate_pose(scene, animation, t);
+  JointMatrices joints(scene, pose);
   PosedScene posed;
   // Depth-first over the displayed scene, children in file order, so object ids are stable.
   std::vector<int> stack(scene.roots.rbegin(), scene.roots.rend());
@@ -238,7 +286,7 @@ PosedScene pose_scene(const Scene& scene, int animation, float t) {
         out.mesh = node.mesh;
         out.primitive = p;
         out.object_id = posed.object_count;
-        pose_primitive(scene, pose, i, mesh.primitives[p], weights, out);
+        pose_primitive(scene, pose, joints, i, mesh.primitives[p], weights, out);
         posed.primitives.push_back(std::move(out));
       }
       ++posed.object_count;

@@ -86,7 +86,7 @@ enum class AnimPath { kTranslation, kRotation, kScale, kWeights };
 enum class Interpolation { kLinear, kStep, kCubicSpline };
 
 struct AnimSampler {
-  std::vector<float> times;   // strictly increasing keyframe times (seconds)
+  std::vector<float> times;   // non-decreasing, finite keyframe times (seconds)
   std::vector<float> values;  // components per key (x3 for cubic spline: in, value, out)
   int components = 0;         // 3, 4 or the morph target count
   Interpolation interpolation = Interpolation::kLinear;
@@ -106,7 +106,12 @@ struct Animation {
   float end = 0.0f;    // latest key time
 };
 
+// Invariants the loader establishes (io/gltf_loader): the nodes form a forest (every child
+// index is valid, no node has two parents, no cycles), roots are distinct parentless nodes,
+// every index (mesh, skin, camera, material, joint, sampler) is in range and every number is
+// finite.
 struct Scene {
+  std::string source;  // the file it was loaded from: the subject of errors about its content
   std::vector<Node> nodes;
   std::vector<int> roots;  // the nodes of the displayed glTF scene
   std::vector<Mesh> meshes;
@@ -133,8 +138,13 @@ struct Pose {
   std::vector<glm::mat4> world;
 };
 
-// Evaluates clip `animation` (-1: the rest pose as stored in the nodes) at time t.
+// Evaluates clip `animation` (-1: the rest pose as stored in the nodes) at time t. Throws
+// emaki::Error (subject: scene.source) when a world transform overflows to a non-finite value.
 Pose evaluate_pose(const Scene& scene, int animation, float t);
+
+// Posed positions further than this from the origin are refused: the renderer's squared
+// distances and bounds stay finite (1e12 m is seven times the Earth-Sun distance).
+inline constexpr float kMaxWorldCoordinate = 1e12f;
 
 // One drawn mesh primitive posed at one time. object_id counts the drawn (node, mesh) pairs in
 // hierarchy order from 0; material is the Scene material index (-1: default).
@@ -157,7 +167,9 @@ struct PosedScene {
 };
 
 // The world-space geometry of every mesh instance at time t of clip `animation` (-1: rest):
-// node transforms, skinning (4 weights per vertex) and morph targets applied.
+// node transforms, skinning (4 weights per vertex) and morph targets applied. Throws
+// emaki::Error (subject: scene.source) when a posed position is not finite or lies beyond
+// kMaxWorldCoordinate: finite inputs can still overflow through chained transforms.
 PosedScene pose_scene(const Scene& scene, int animation, float t);
 
 struct Bounds {
