@@ -129,7 +129,7 @@ TEST_F(ImageIo, NanInExrIsRejected) {
 
 TEST_F(ImageIo, CorruptAndMissingFilesNameTheFile) {
   std::ofstream(p("c.png"), std::ios::binary) << "\x89PNG\r\n\x1a\n\0\0\0\rIHDR";
-  for (const std::string f : {p("c.png"), p("missing.png")}) {
+  for (const std::string& f : {p("c.png"), p("missing.png")}) {
     try {
       read_image(f);
       FAIL() << f;
