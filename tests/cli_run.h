@@ -107,6 +107,22 @@ inline CliResult run_cli(const std::string& binary, const std::vector<std::strin
   return r;
 }
 
+// Starts `binary args...` in the background with stderr to `err_path`; the caller waits for it.
+inline pid_t spawn_cli(const std::string& binary, const std::vector<std::string>& args,
+                       const std::string& err_path) {
+  const pid_t pid = ::fork();
+  if (pid != 0) return pid;
+  const int e = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  if (e < 0) ::_exit(126);
+  ::dup2(e, 2);
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(binary.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  ::execv(binary.c_str(), argv.data());
+  ::_exit(127);
+}
+
 // Splits a command line on spaces (tests only pass paths without spaces).
 inline std::vector<std::string> split_args(const std::string& line) {
   std::vector<std::string> v;

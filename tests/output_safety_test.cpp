@@ -19,6 +19,7 @@
 #include "cli_run.h"
 #include "core/image.h"
 #include "io/image_io.h"
+#include "tests/small_painting.h"
 
 namespace fs = std::filesystem;
 using namespace emaki;
@@ -80,16 +81,7 @@ class OutputSafety : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    const Image<float> big = io::read_image_float(kData + "/stylit/source_style.png");
-    const int w = 100, h = 76;
-    Image<float> small(w, h, 3);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c)
-          small(x, y, c) = big(x * big.width() / w, y * big.height() / h, c);
-    io::WriteOptions wo;
-    wo.format = io::SampleFormat::kU8;
-    io::write_image(p("painting.png"), small.cview(), wo);
+    test::write_small_painting(kData + "/stylit/source_style.png", p("painting.png"));
   }
   void TearDown() override {
     std::error_code ec;
@@ -200,15 +192,8 @@ TEST_F(OutputSafety, PlantedSymlinksAreNeverWrittenThrough) {
   fs::create_symlink(dir_ / "victim2.txt", dir_ / "out/composite/frame_0005.png");
 
   const std::string err_path = p("stderr.txt");
-  const pid_t pid = ::fork();
+  const pid_t pid = test::spawn_cli(EMAKI_BINARY, {"run", p("shot.toml")}, err_path);
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int e = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    ::dup2(e, 2);
-    const std::string shot = p("shot.toml");
-    ::execl(EMAKI_BINARY, EMAKI_BINARY, "run", shot.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   // Temporaries used to be ".<stem>.tmp<pid><ext>": once the run is under way (past its
   // start-up clean-up), plant links at the names its later frames would have used.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
@@ -270,15 +255,8 @@ TEST_F(OutputSafety, SecondRunOnTheSameFolderNamesTheHolder) {
   t.h = 48;
   write_shot(t);
   const std::string err_path = p("first_stderr.txt");
-  const pid_t first = ::fork();
+  const pid_t first = test::spawn_cli(EMAKI_BINARY, {"run", p("shot.toml")}, err_path);
   ASSERT_GE(first, 0);
-  if (first == 0) {
-    const int e = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    ::dup2(e, 2);
-    const std::string shot = p("shot.toml");
-    ::execl(EMAKI_BINARY, EMAKI_BINARY, "run", shot.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   // The holder writes its pid into the lock file once it holds the lock.
   const fs::path lock = dir_ / "out/.emaki.lock";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);

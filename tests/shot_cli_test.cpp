@@ -21,6 +21,7 @@
 
 #include "core/image.h"
 #include "io/image_io.h"
+#include "tests/small_painting.h"
 
 extern char** environ;
 
@@ -108,23 +109,7 @@ class ShotCli : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    // A 100x76 copy of the StyLit painting (box filter), so exemplar pyramids stay tiny.
-    const Image<float> big = io::read_image_float(kData + "/stylit/source_style.png");
-    const int w = 100, h = 76;
-    Image<float> small(w, h, 3);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) {
-          const int x0 = x * big.width() / w, x1 = (x + 1) * big.width() / w;
-          const int y0 = y * big.height() / h, y1 = (y + 1) * big.height() / h;
-          double s = 0;
-          for (int yy = y0; yy < y1; ++yy)
-            for (int xx = x0; xx < x1; ++xx) s += big(xx, yy, c);
-          small(x, y, c) = float(s / ((x1 - x0) * (y1 - y0)));
-        }
-    io::WriteOptions wo;
-    wo.format = io::SampleFormat::kU8;
-    io::write_image(p("painting.png"), small.cview(), wo);
+    test::write_small_painting(kData + "/stylit/source_style.png", p("painting.png"));
   }
   void TearDown() override { fs::remove_all(dir_); }
 
