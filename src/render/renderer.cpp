@@ -6,6 +6,7 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "core/error.h"
@@ -206,7 +207,8 @@ class ShadowMap {
     proj_.width = proj_.height = size;
     size_ = size;
     texel_ = 2.0f * radius_ / size;
-    tan_half_ = std::tan(0.5f * std::clamp(softness_deg, 0.0f, 45.0f) * 3.14159265f / 180.0f);
+    tan_half_ =
+        std::tan(0.5f * std::clamp(softness_deg, 0.0f, 45.0f) * std::numbers::pi_v<float> / 180.0f);
     std::vector<ClipVertex> verts(g.pos.size());
     for (std::size_t v = 0; v < g.pos.size(); ++v) verts[v] = proj_.clip(g.pos[v]);
     std::vector<uint32_t> idx(g.indices.begin(), g.indices.begin() + g.caster_indices);
@@ -329,7 +331,7 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
                g.tris[t].face_normal};
   }
   const float cos_crease =
-      std::cos(std::clamp(opt.crease_deg, 0.0f, 180.0f) * 3.14159265f / 180.0f);
+      std::cos(std::clamp(opt.crease_deg, 0.0f, 180.0f) * std::numbers::pi_v<float> / 180.0f);
   const float jump = opt.depth_jump;
   // Relative error of predicting sample b's depth from the plane of sample a's triangle.
   auto plane_error = [&](const OutlineTri& ta, int bx, int by, float depth_b) {
