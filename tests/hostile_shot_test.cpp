@@ -221,6 +221,26 @@ TEST_F(HostileShot, BadKeysNameTheirKeyPath) {
   }
 }
 
+// Errors the renderer and the reference sphere find name a neutral field; the shot file layer
+// re-spells it as the key the user wrote (not a command-line option, not a guessed key).
+TEST_F(HostileShot, RendererAndSphereErrorsNameTheirKey) {
+  struct BadKey {
+    Slots slots;
+    std::string key;
+  };
+  const std::vector<BadKey> cases = {
+      {{{"SCENE", "scene = \"@DATA@/scenes/Fox.glb\"\nclip = \"Nope\""}}, "source.clip"},
+      {{{"SOURCE", "start = 1000"}}, "source.start"},
+      {{{"FRAMES", "[0, 500]"}}, "source.frames"},
+      {{{"CAMERA", "mode = \"gltf\"\ngltf_node = 0"}}, "source.camera.gltf_node"},
+      {{{"EXEMPLAR", "horizon = -100000"}}, "exemplars.sphere.horizon"},
+  };
+  for (const BadKey& c : cases) {
+    SCOPED_TRACE(c.key);
+    expect_bad_shot(shot_text(c.slots), c.key);
+  }
+}
+
 // ---- 7. limits.max_pixels and --max-pixels ----
 
 TEST_F(HostileShot, CommandLineMaxPixelsOverridesTheShots) {

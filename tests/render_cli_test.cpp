@@ -141,8 +141,8 @@ TEST_F(RenderCli, RequiredExtensionNotSupported) {
 }
 
 TEST_F(RenderCli, TooManySamples) {
-  expect_failure("render " + kScenes + "Fox.glb --size 16000x9000 --aa 3 --out " + out(), "--aa",
-                 "lower --aa or --size");
+  expect_failure("render " + kScenes + "Fox.glb --size 16000x9000 --aa 3 --out " + out(),
+                 "emaki render: error: --aa: ", "lower the antialiasing or the size");
 }
 
 TEST_F(RenderCli, EmptyScene) {
@@ -157,6 +157,19 @@ TEST_F(RenderCli, FrameRangeOutsideTheClip) {
   expect_failure(
       "render " + kScenes + "Fox.glb --clip Walk --frames 0-500 --size 64x48 --out " + out(),
       "--frames", "past the end of clip 'Walk'");
+}
+
+// The renderer names a neutral field ("clip", "start", "gltf_node"); the command line re-spells
+// it as the option the user typed.
+TEST_F(RenderCli, RendererErrorsNameTheirOption) {
+  const std::string fox = "render " + kScenes + "Fox.glb --size 64x48 --out " + out();
+  expect_failure(fox + " --clip Nope", "emaki render: error: --clip: ", "no clip 'Nope'");
+  expect_failure(fox + " --clip Walk --start 1000",
+                 "emaki render: error: --start: ", "outside clip 'Walk'");
+  expect_failure(fox + " --clip Walk --frames 0-500",
+                 "emaki render: error: --frames: ", "past the end of clip 'Walk'");
+  expect_failure(fox + " --gltf-camera 0",
+                 "emaki render: error: --gltf-camera: ", "is not a camera node");
 }
 
 TEST_F(RenderCli, CameraSeesNothing) {

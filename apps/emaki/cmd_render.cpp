@@ -10,6 +10,7 @@
 #include <string>
 
 #include "apps/emaki/commands.h"
+#include "apps/emaki/frame_range.h"
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
 #include "core/limits.h"
@@ -22,31 +23,6 @@ namespace emaki::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// "A-B" or "A", each in [0, kMaxFrame], at most kMaxFrameCount frames: parsed as 64-bit and
-// bounded, so no frame arithmetic downstream can overflow.
-void parse_frames(const std::string& text, int& first, int& last) {
-  const std::string usage =
-      fmt::format("expects A-B or A (frame numbers in [0, {}], at most {} frames), got '{}'",
-                  kMaxFrame, kMaxFrameCount, echo(text));
-  long long a = 0, b = 0;
-  try {
-    std::size_t pos = 0;
-    const std::size_t dash = text.find('-', 1);
-    a = std::stoll(text.substr(0, dash), &pos);
-    if (pos != std::min(dash, text.size())) throw std::invalid_argument(text);
-    b = a;
-    if (dash != std::string::npos) {
-      b = std::stoll(text.substr(dash + 1), &pos);
-      if (pos != text.size() - dash - 1) throw std::invalid_argument(text);
-    }
-  } catch (const std::exception&) {
-    throw Error("--frames", usage);
-  }
-  if (a < 0 || b < a || b > kMaxFrame || b - a >= kMaxFrameCount) throw Error("--frames", usage);
-  first = int(a);
-  last = int(b);
-}
 
 void make_dir(const std::string& option, const fs::path& dir) {
   std::error_code ec;
@@ -113,7 +89,9 @@ int run_render(const Args& args) {
   scene::ShotSpec shot;
   render::RenderOptions options;
   so.resolve(shot, options);
-  parse_frames(frames, shot.first_frame, shot.last_frame);
+  const FrameRange range = parse_frame_range("--frames", frames);
+  shot.first_frame = range.first;
+  shot.last_frame = range.last;
   check_number("--fps", fps, render::kMinFps, render::kMaxFps);
   check_number("--start", start_time, 0.0f, 1e7f);
   shot.fps = fps;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "apps/emaki/commands.h"
+#include "apps/emaki/frame_range.h"
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
 #include "core/limits.h"
@@ -24,28 +25,12 @@ namespace emaki::app {
 
 namespace {
 
-// "A-B" or "A".
+// --frames is optional here: empty leaves the shot's whole range (first/last_frame < 0).
 void parse_frames(const std::string& text, pipeline::RunOptions& o) {
   if (text.empty()) return;
-  try {
-    std::size_t p = 0;
-    const std::size_t dash = text.find('-', 1);
-    o.first_frame = std::stoi(text.substr(0, dash), &p);
-    if (p != (dash == std::string::npos ? text.size() : dash)) throw std::invalid_argument(text);
-    if (dash == std::string::npos) {
-      o.last_frame = o.first_frame;
-    } else {
-      o.last_frame = std::stoi(text.substr(dash + 1), &p);
-      if (p != text.size() - dash - 1) throw std::invalid_argument(text);
-    }
-  } catch (const std::exception&) {
-    throw Error("--frames",
-                fmt::format("expects FIRST-LAST or FRAME, e.g. 0-47, got '{}'", echo(text)));
-  }
-  if (o.first_frame < 0 || o.last_frame < 0 || o.first_frame > kMaxFrame ||
-      o.last_frame > kMaxFrame)
-    throw Error("--frames",
-                fmt::format("frames must be in [0, {}], got '{}'", kMaxFrame, echo(text)));
+  const FrameRange r = parse_frame_range("--frames", text);
+  o.first_frame = r.first;
+  o.last_frame = r.last;
 }
 
 std::vector<std::string> split_commas(const std::string& text) {

@@ -28,6 +28,26 @@ const std::vector<Command>& commands() {
 }
 
 namespace {
+
+// The command line's spelling of each neutral field (Error::Field) an error from below apps/ can
+// name: the one place a field becomes an option. A field missing here keeps its neutral name,
+// which is true if not the option's spelling.
+struct FieldOption {
+  const char* field;
+  const char* option;
+};
+constexpr FieldOption kFieldOptions[] = {
+    {"frames", "--frames"}, {"fps", "--fps"},         {"clip", "--clip"},
+    {"start", "--start"},   {"aa", "--aa"},           {"gltf_node", "--gltf-camera"},
+    {"sphere", "--sphere"}, {"horizon", "--horizon"}, {"layers", "--layers"},
+};
+
+std::string error_text(const emaki::Error& e) {
+  for (const FieldOption& f : kFieldOptions)
+    if (e.field() == f.field) return e.respelled(f.option).what();
+  return e.what();
+}
+
 void print_usage() {
   std::printf("emaki — stylize 3D animation by example\n\nusage: emaki <command> [options]\n\n");
   for (const auto& c : commands()) std::printf("  %-10s %s\n", c.name, c.summary);
@@ -71,6 +91,9 @@ int main(int argc, char** argv) {
     if (name != c.name) continue;
     try {
       return c.run(args);
+    } catch (const emaki::Error& e) {
+      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, error_text(e).c_str());
+      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "emaki %s: error: %s\n", c.name, e.what());
       return 1;

@@ -70,8 +70,9 @@ scene::ShotSpec reference_shot(const ReferenceSpec& spec) {
   // On the optical axis a sphere's outline is a circle of angular radius asin(1 / distance).
   const float alpha = std::atan(circle.z / focal);
   if (!(alpha > 0.0f) || alpha > 80.0f * kDeg)
-    throw Error("--sphere", fmt::format("radius {} px does not fit a {} degree field of view",
-                                        circle.z, spec.fov_deg));
+    throw Error(
+        Error::Field{"sphere"},
+        fmt::format("radius {} px does not fit a {} degree field of view", circle.z, spec.fov_deg));
   const float distance = 1.0f / std::sin(alpha);
 
   scene::ShotSpec shot;
@@ -87,7 +88,8 @@ scene::ShotSpec reference_shot(const ReferenceSpec& spec) {
     elevation = std::atan((y_ndc - cam.shift.y) * tan_half);
   }
   if (std::abs(elevation) > 80.0f * kDeg)
-    throw Error("--horizon", "puts the camera more than 80 degrees above or below the horizon");
+    throw Error(Error::Field{"horizon"},
+                "puts the camera more than 80 degrees above or below the horizon");
   cam.target = glm::vec3(0.0f, 1.0f, 0.0f);
   cam.has_target = true;
   cam.position = cam.target + distance * glm::vec3(0.0f, std::sin(elevation), std::cos(elevation));

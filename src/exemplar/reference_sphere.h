@@ -32,8 +32,9 @@ struct ReferenceSpec {
 // A UV sphere of radius 1 centred at (0, 1, 0) (resting on y = 0), with exact normals.
 scene::Scene sphere_scene(int rings = 128);
 
-// The shot that frames the sphere as `spec` asks (a single frame, 0). Throws emaki::Error for
-// a sphere that does not fit the camera ("--sphere") or a horizon that cannot be reached.
+// The shot that frames the sphere as `spec` asks (a single frame, 0). Throws emaki::Error naming
+// the field (Error::Field) for a sphere that does not fit the camera ("sphere") or a horizon
+// that cannot be reached ("horizon").
 scene::ShotSpec reference_shot(const ReferenceSpec& spec);
 
 // The sphere's centre and radius in pixels for `spec` (defaults resolved).

@@ -79,12 +79,35 @@ Image<float> read_pass_file(const std::string& file, const std::string& preset,
 
 namespace {
 
-// Errors from the renderer name its command-line options; here they are shot file keys.
-[[noreturn]] void rethrow_as_key(const Error& e, const std::string& key) {
-  std::string message = e.what();
-  if (!e.subject().empty() && message.rfind(e.subject() + ": ", 0) == 0)
-    message = message.substr(e.subject().size() + 2);
-  throw Error(key, message);
+// The shot file's spelling of each neutral field (Error::Field) the loaders below can meet: the
+// one place a field becomes a key. `section` is the table the field sits in; an exemplar's key
+// takes its name ("exemplars.NAME.sphere").
+struct ShotKey {
+  const char* field;
+  const char* section;
+  const char* key;
+};
+constexpr ShotKey kShotKeys[] = {
+    {"frames", "source", "frames"},
+    {"fps", "source", "fps"},
+    {"clip", "source", "clip"},
+    {"start", "source", "start"},
+    {"aa", "source", "aa"},
+    {"gltf_node", "source", "camera.gltf_node"},
+    {"sphere", "exemplars", "sphere"},
+    {"horizon", "exemplars", "horizon"},
+};
+
+// Rethrows `e` named by its shot file key under `table` ("source" or "exemplars.NAME"). An error
+// that names no field (a file path) is rethrown as it is; a field with no key here keeps its
+// neutral name, which is true, rather than a guessed key, and is marked as spelled so that the
+// command line does not re-spell it as one of its options.
+[[noreturn]] void rethrow_as_key(const Error& e, const std::string& table) {
+  if (e.field().empty()) throw e;
+  const std::string section = table.substr(0, table.find('.'));
+  for (const ShotKey& k : kShotKeys)
+    if (e.field() == k.field && section == k.section) throw e.respelled(table + "." + k.key);
+  throw e.respelled(e.subject());
 }
 
 class SequenceFrames : public pipeline::FrameSource {
@@ -174,9 +197,7 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
   try {
     return pipeline::scene_frames(std::move(scene), s);
   } catch (const Error& e) {
-    rethrow_as_key(e, e.subject() == "--clip"    ? "source.clip"
-                      : e.subject() == "--start" ? "source.start"
-                                                 : "source.frames");
+    rethrow_as_key(e, "source");
   }
 }
 
@@ -191,7 +212,7 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
       try {
         im.passes = pipeline::matcap_passes(e, w, h);
       } catch (const Error& err) {
-        rethrow_as_key(err, key + (err.subject() == "--horizon" ? ".horizon" : ".sphere"));
+        rethrow_as_key(err, key);
       }
     } else {
       // Read the passes the layers use as guides; the rest stay zero.

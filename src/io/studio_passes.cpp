@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 
 #include "core/error.h"
 #include "render/passes.h"
@@ -294,7 +295,7 @@ Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
       }
 
   // Outline: id changes (not ground against background), depth jumps, creases; both sides.
-  const float crease = std::cos(45.0f * 3.14159265f / 180.0f);
+  const float crease = std::cos(45.0f * std::numbers::pi_v<float> / 180.0f);
   auto edge = [&](const float* p, const float* q) {
     const bool pc = p[kAlpha] > 0.5f, qc = q[kAlpha] > 0.5f;
     if (p[kObjectId] != q[kObjectId]) {

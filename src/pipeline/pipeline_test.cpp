@@ -230,7 +230,7 @@ TEST(Pipeline, UnknownLayerOptionIsAnError) {
     run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, store, o);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_EQ(e.subject(), "--layers");
+    EXPECT_EQ(e.field(), "layers");  // a neutral name: each front end re-spells it
   }
 }
 

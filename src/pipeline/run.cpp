@@ -125,7 +125,8 @@ std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<st
     if (!l) {
       std::string known;
       for (const Layer& k : shot.layers) known += (known.empty() ? "" : ", ") + k.name;
-      throw Error("--layers", fmt::format("no layer '{}' in the shot (layers: {})", n, known));
+      throw Error(Error::Field{"layers"},
+                  fmt::format("no layer '{}' in the shot (layers: {})", n, known));
     }
     if (std::find(out.begin(), out.end(), l) == out.end()) out.push_back(l);
   }
@@ -135,10 +136,11 @@ std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<st
 void resolve_range(const Shot& shot, const RunOptions& o, int& a, int& b) {
   a = o.first_frame < 0 ? shot.source.first_frame : o.first_frame;
   b = o.last_frame < 0 ? shot.source.last_frame : o.last_frame;
-  if (a > b) throw Error("--frames", fmt::format("the range {}-{} is reversed", a, b));
+  if (a > b) throw Error(Error::Field{"frames"}, fmt::format("the range {}-{} is reversed", a, b));
   if (a < shot.source.first_frame || b > shot.source.last_frame)
-    throw Error("--frames", fmt::format("{}-{} leaves the shot's frames {}-{}", a, b,
-                                        shot.source.first_frame, shot.source.last_frame));
+    throw Error(Error::Field{"frames"},
+                fmt::format("{}-{} leaves the shot's frames {}-{}", a, b, shot.source.first_frame,
+                            shot.source.last_frame));
 }
 
 }  // namespace

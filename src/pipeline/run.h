@@ -68,7 +68,8 @@ struct CompositeInputs {
 
 // Runs (or resumes) the shot over the requested frames and layers. `exemplars` maps exemplar
 // names to their images. Throws emaki::Error for what a user can fix (a size that does not
-// match, an unknown layer in options.layers).
+// match; an unknown layer in options.layers or a range outside the shot, named by the fields
+// "layers" and "frames").
 RunReport run_shot(const Shot& shot, const FrameSource& frames,
                    const std::map<std::string, ExemplarImages>& exemplars,
                    const CompositeInputs& composite_inputs, Store& store,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "core/error.h"
@@ -206,7 +207,8 @@ class ShadowMap {
     proj_.width = proj_.height = size;
     size_ = size;
     texel_ = 2.0f * radius_ / size;
-    tan_half_ = std::tan(0.5f * std::clamp(softness_deg, 0.0f, 45.0f) * 3.14159265f / 180.0f);
+    tan_half_ =
+        std::tan(0.5f * std::clamp(softness_deg, 0.0f, 45.0f) * std::numbers::pi_v<float> / 180.0f);
     std::vector<ClipVertex> verts(g.pos.size());
     for (std::size_t v = 0; v < g.pos.size(); ++v) verts[v] = proj_.clip(g.pos[v]);
     std::vector<uint32_t> idx(g.indices.begin(), g.indices.begin() + g.caster_indices);
@@ -329,7 +331,7 @@ void draw_outline(const VisibilityBuffer& vb, const FrameGeometry& g, const Proj
                g.tris[t].face_normal};
   }
   const float cos_crease =
-      std::cos(std::clamp(opt.crease_deg, 0.0f, 180.0f) * 3.14159265f / 180.0f);
+      std::cos(std::clamp(opt.crease_deg, 0.0f, 180.0f) * std::numbers::pi_v<float> / 180.0f);
   const float jump = opt.depth_jump;
   // Relative error of predicting sample b's depth from the plane of sample a's triangle.
   auto plane_error = [&](const OutlineTri& ta, int bx, int by, float depth_b) {
@@ -466,15 +468,18 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
   // The visibility buffer holds 16 bytes per sample for the whole frame.
   const double samples = double(options_.width) * options_.height * options_.aa * options_.aa;
   if (samples > kMaxSamples)
-    throw Error("--aa", fmt::format("{}x{} pixels with {}x{} samples each need {:.1f} GB of sample "
-                                    "buffers (limit {:.1f} GB); lower --aa or --size",
-                                    options_.width, options_.height, options_.aa, options_.aa,
-                                    samples * 16 / 1e9, kMaxSamples * 16 / 1e9));
+    throw Error(Error::Field{"aa"},
+                fmt::format("{}x{} pixels with {}x{} samples each need {:.1f} GB of sample "
+                            "buffers (limit {:.1f} GB); lower the antialiasing or the size",
+                            options_.width, options_.height, options_.aa, options_.aa,
+                            samples * 16 / 1e9, kMaxSamples * 16 / 1e9));
   // Front ends check these with their own names; this is the last line for any other caller.
   if (!(shot_.fps >= kMinFps && shot_.fps <= kMaxFps))
-    throw Error("--fps", fmt::format("must be in [{}, {}], got {}", kMinFps, kMaxFps, shot_.fps));
+    throw Error(Error::Field{"fps"},
+                fmt::format("must be in [{}, {}], got {}", kMinFps, kMaxFps, shot_.fps));
   if (!std::isfinite(shot_.start_time) || shot_.start_time < 0.0f)
-    throw Error("--start", fmt::format("must be a finite number >= 0, got {}", shot_.start_time));
+    throw Error(Error::Field{"start"},
+                fmt::format("must be a finite number >= 0, got {}", shot_.start_time));
   if (!shot_.clip.empty()) {
     animation_ = scene.find_animation(shot_.clip);
     if (animation_ < 0) {
@@ -484,8 +489,9 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
         names += (names.empty() ? "'" : ", '") + echo(scene.animations[i].name, 40) + "'";
       if (scene.animations.size() > 16)
         names += fmt::format(", ... ({} more)", scene.animations.size() - 16);
-      throw Error("--clip", fmt::format("no clip '{}' in the scene (clips: {})", echo(shot_.clip),
-                                        names.empty() ? "none" : names));
+      throw Error(Error::Field{"clip"},
+                  fmt::format("no clip '{}' in the scene (clips: {})", echo(shot_.clip),
+                              names.empty() ? "none" : names));
     }
   } else if (!scene.animations.empty()) {
     animation_ = 0;
@@ -494,33 +500,35 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
   // never overflow, and --frames 2147483647 --loop is refused instead of spinning forever.
   if (shot_.first_frame < 0 || shot_.last_frame < shot_.first_frame ||
       shot_.last_frame > kMaxFrame || shot_.last_frame - shot_.first_frame >= kMaxFrameCount)
-    throw Error("--frames",
+    throw Error(Error::Field{"frames"},
                 fmt::format("invalid frame range {}-{} (frames in [0, {}], at most {} of them)",
                             shot_.first_frame, shot_.last_frame, kMaxFrame, kMaxFrameCount));
   if (animation_ >= 0) {
     const scene::Animation& a = scene.animations[animation_];
     const float duration = a.end - a.start;
     if (!std::isfinite(duration))
-      throw Error("--clip", fmt::format("clip '{}' has no finite length", echo(a.name)));
+      throw Error(Error::Field{"clip"},
+                  fmt::format("clip '{}' has no finite length", echo(a.name)));
     if (shot_.start_time > duration)
-      throw Error("--start", fmt::format("{} s is outside clip '{}' ({:.3f} s long)",
-                                         shot_.start_time, echo(a.name), duration));
+      throw Error(Error::Field{"start"}, fmt::format("{} s is outside clip '{}' ({:.3f} s long)",
+                                                     shot_.start_time, echo(a.name), duration));
     // In double and clamped: a clip of 1e30 s must not overflow the int.
     const double frames_in_clip =
         std::floor((double(duration) - shot_.start_time) * shot_.fps + 1e-3);
     const int last_frame = int(std::min<double>(frames_in_clip, kMaxFrame));
     if (!shot_.loop && shot_.last_frame > last_frame)
-      throw Error("--frames",
-                  fmt::format("frame {} is at {:.3f} s, past the end of clip '{}' "
-                              "({:.3f} s long: frames 0-{} at {} fps from {} s; --loop plays it "
-                              "in a loop)",
-                              shot_.last_frame, shot_.start_time + shot_.last_frame / shot_.fps,
-                              echo(a.name), duration, last_frame, shot_.fps, shot_.start_time));
+      throw Error(
+          Error::Field{"frames"},
+          fmt::format("frame {} is at {:.3f} s, past the end of clip '{}' "
+                      "({:.3f} s long: frames 0-{} at {} fps from {} s; a looping clip may run "
+                      "past its end)",
+                      shot_.last_frame, shot_.start_time + shot_.last_frame / shot_.fps,
+                      echo(a.name), duration, last_frame, shot_.fps, shot_.start_time));
   }
   if (shot_.camera.mode == scene::CameraSpec::Mode::kGltf) {
     const int n = shot_.camera.gltf_node;
     if (n < 0 || n >= int(scene.nodes.size()) || scene.nodes[n].camera < 0)
-      throw Error("--gltf-camera", fmt::format("node {} is not a camera node", n));
+      throw Error(Error::Field{"gltf_node"}, fmt::format("node {} is not a camera node", n));
   }
   // The boxes are fixed for the shot, so normalised values compare across frames. They come
   // from every frame of a range up to kMaxBoundsFrames long (so results do not change for any

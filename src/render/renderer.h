@@ -32,10 +32,10 @@ struct RenderOptions {
 // other frame's.
 class ShotRenderer {
  public:
-  // Throws emaki::Error for a clip that is not in the scene ("--clip"), a start time or frame
-  // range that leaves the clip ("--start", "--frames"), a node that is not a camera
-  // ("--gltf-camera") or more samples than the sample buffers allow ("--aa"). `scene` must
-  // outlive the renderer.
+  // Throws emaki::Error naming a field (Error::Field; front ends re-spell it) for a clip that is
+  // not in the scene ("clip"), a start time or frame range that leaves the clip ("start",
+  // "frames"), a node that is not a camera ("gltf_node") or more samples than the sample buffers
+  // allow ("aa"). `scene` must outlive the renderer.
   ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& shot,
                const RenderOptions& options);
 

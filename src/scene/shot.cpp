@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <numbers>
 #include <vector>
 
 namespace emaki::scene {
@@ -12,7 +13,7 @@ glm::vec3 ViewCamera::position() const {
 }
 
 namespace {
-constexpr float kDeg = 3.14159265358979f / 180.0f;
+constexpr float kDeg = std::numbers::pi_v<float> / 180.0f;
 
 glm::mat4 look_at(const glm::vec3& eye, const glm::vec3& target) {
   glm::vec3 fwd = target - eye;
