@@ -52,6 +52,16 @@ inline std::string slurp_file(const std::filesystem::path& p) {
   return ss.str();
 }
 
+// In a forked child: replaces it with `binary args...` (exit code 127 when that fails).
+[[noreturn]] inline void exec_cli(const std::string& binary, const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(binary.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  ::execv(binary.c_str(), argv.data());
+  ::_exit(127);
+}
+
 // Runs `binary args...`; stdout and stderr are captured through files in a temporary folder.
 inline CliResult run_cli(const std::string& binary, const std::vector<std::string>& args,
                          const CliOptions& opt = {}) {
@@ -77,12 +87,7 @@ inline CliResult run_cli(const std::string& binary, const std::vector<std::strin
     }
 #endif
     for (const auto& kv : opt.env) ::putenv(const_cast<char*>(kv.c_str()));
-    std::vector<char*> argv;
-    argv.push_back(const_cast<char*>(binary.c_str()));
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(binary.c_str(), argv.data());
-    ::_exit(127);
+    exec_cli(binary, args);
   }
   CliResult r;
   int status = 0;
@@ -115,12 +120,7 @@ inline pid_t spawn_cli(const std::string& binary, const std::vector<std::string>
   const int e = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   if (e < 0) ::_exit(126);
   ::dup2(e, 2);
-  std::vector<char*> argv;
-  argv.push_back(const_cast<char*>(binary.c_str()));
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  ::execv(binary.c_str(), argv.data());
-  ::_exit(127);
+  exec_cli(binary, args);
 }
 
 // Splits a command line on spaces (tests only pass paths without spaces).

@@ -24,15 +24,6 @@ const fs::path kHostile = fs::path(EMAKI_HOSTILE) / "gltf";
 
 class HostileGltf : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_hostile_gltf_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path write(const fs::path& rel, const std::string& bytes) {
     const fs::path p = dir_ / rel;
     fs::create_directories(p.parent_path());
@@ -64,7 +55,10 @@ class HostileGltf : public ::testing::Test {
     EXPECT_TRUE(out_is_empty()) << scene;
   }
 
-  fs::path dir_;
+  emaki::test::TempDir tmp_{
+      "hostile_gltf_" +
+      std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())};
+  fs::path dir_ = tmp_.path();
   fs::path cwd_;  // empty: the test's own
 };
 

@@ -154,16 +154,10 @@ std::string exr_many_parts(int parts) {
 class HostileImage : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_hostile_image_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     write_image("style.png", 48, 40, 3);
     write_image("guide.png", 48, 40, 1);
     write_image("target.png", 56, 44, 1);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string p(const std::string& name) const { return (dir_ / name).string(); }
 
@@ -197,7 +191,10 @@ class HostileImage : public ::testing::Test {
     EXPECT_FALSE(fs::exists(p("out.png")));
   }
 
-  fs::path dir_;
+  emaki::test::TempDir tmp_{
+      "hostile_image_" +
+      std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())};
+  fs::path dir_ = tmp_.path();
 };
 
 TEST_F(HostileImage, EveryReproducerIsRejectedInTheStyleSlot) {

@@ -83,15 +83,6 @@ std::string shot_text(const Slots& over) {
 
 class HostileShot : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_hostile_shot_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string p(const std::string& name) const { return (dir_ / name).string(); }
   void write(const std::string& name, const std::string& text) const {
     std::ofstream(p(name), std::ios::binary) << text;
@@ -127,7 +118,10 @@ class HostileShot : public ::testing::Test {
     expect_refused(emaki(args), "run", subject);
   }
 
-  fs::path dir_;
+  emaki::test::TempDir tmp_{
+      "hostile_shot_" +
+      std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())};
+  fs::path dir_ = tmp_.path();
 };
 
 // The base shot is valid up to its output: a bad case fails because of its one change.

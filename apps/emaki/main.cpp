@@ -51,7 +51,9 @@ std::string error_text(const emaki::Error& e) {
 void print_usage() {
   std::printf("emaki — stylize 3D animation by example\n\nusage: emaki <command> [options]\n\n");
   for (const auto& c : commands()) std::printf("  %-10s %s\n", c.name, c.summary);
-  std::printf("\n'emaki <command> --help' documents a command's options.\n");
+  std::printf(
+      "\n'emaki <command> --help' documents a command's options. Every command also takes\n"
+      "--max-pixels N: the largest image, in pixels, read or made (default 2^28).\n");
 }
 }  // namespace
 }  // namespace emaki::app
