@@ -11,10 +11,10 @@
 #include <string>
 
 #include "core/parallel.h"
-#include "io/shot_file.h"
-#include "io/shot_inputs.h"
 #include "memory_store.h"
 #include "pipeline/run.h"
+#include "shot/inputs.h"
+#include "shot/shot.h"
 
 int main(int argc, char** argv) {
   using namespace emaki;
@@ -27,14 +27,14 @@ int main(int argc, char** argv) {
   if (argc > 3) threads = std::atoi(argv[3]);
   set_thread_count(threads);
   try {
-    pipeline::Shot shot = io::load_shot(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
+    pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
     shot.source.width = shot.source.render.width = width;
     shot.source.height = shot.source.render.height = height;
     shot.source.last_frame = shot.source.first_frame + frames - 1;
     shot.source.shot.last_frame = shot.source.last_frame;
-    const auto source = io::open_frames(shot);
-    const auto exemplars = io::load_exemplars(shot);
-    const pipeline::CompositeInputs ci = io::load_composite_inputs(shot);
+    const auto source = shot::open_frames(shot);
+    const auto exemplars = shot::load_exemplars(shot);
+    const pipeline::CompositeInputs ci = shot::load_composite_inputs(shot);
     bench::MemoryStore store;
     std::vector<double> seconds;
     auto t = std::chrono::steady_clock::now();

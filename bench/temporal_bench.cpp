@@ -28,13 +28,13 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
-#include "io/shot_file.h"
-#include "io/shot_inputs.h"
 #include "memory_store.h"
 #include "pipeline/flicker.h"
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "render/passes.h"
+#include "shot/inputs.h"
+#include "shot/shot.h"
 
 namespace {
 
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
   const Options opt = parse(argc, argv);
   set_thread_count(opt.threads);
   try {
-    pipeline::Shot shot = io::load_shot(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
+    pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
     shot.source.width = shot.source.render.width = opt.width;
     shot.source.height = shot.source.render.height = opt.height;
     shot.source.last_frame = shot.source.first_frame + opt.frames - 1;
@@ -134,9 +134,9 @@ int main(int argc, char** argv) {
     for (pipeline::Layer& l : shot.layers)
       if (l.name == opt.layer) layer = &l;
     if (!layer) usage("no layer " + opt.layer + " in the example");
-    const auto source = io::open_frames(shot);
-    const auto exemplars = io::load_exemplars(shot);
-    const pipeline::CompositeInputs ci = io::load_composite_inputs(shot);
+    const auto source = shot::open_frames(shot);
+    const auto exemplars = shot::load_exemplars(shot);
+    const pipeline::CompositeInputs ci = shot::load_composite_inputs(shot);
     const int first = shot.source.first_frame, last = shot.source.last_frame;
     const int value_channels = layer->single_colour ? 1 : 3;
 

@@ -1,4 +1,4 @@
-// Fuzz target `shot`: the shot-file parser (io::parse_shot) on arbitrary bytes. Every input
+// Fuzz target `shot`: the shot-file parser (shot::parse_shot) on arbitrary bytes. Every input
 // must end in a parsed shot or an emaki::Error; anything else escaping, a sanitizer report, a
 // leak, > 2 GB or > 30 s is a bug.
 //
@@ -18,7 +18,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
-#include "io/shot_file.h"
+#include "shot/shot_file.h"
 
 namespace {
 
@@ -42,7 +42,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return make_home();
   }();
   try {
-    (void)emaki::io::parse_shot(std::string_view(reinterpret_cast<const char*>(data), size), path);
+    (void)emaki::shot::parse_shot(std::string_view(reinterpret_cast<const char*>(data), size),
+                                  path);
   } catch (const emaki::Error&) {
   }
   return 0;

@@ -15,10 +15,11 @@
 #include "cli_run.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "io/frame_sequence.h"
 #include "io/image_io.h"
-#include "io/shot_file.h"
-#include "io/shot_inputs.h"
 #include "render/passes.h"
+#include "shot/inputs.h"
+#include "shot/shot.h"
 
 namespace fs = std::filesystem;
 using emaki::test::CliResult;
@@ -127,7 +128,7 @@ class HostileShot : public ::testing::Test {
 // The base shot is valid up to its output: a bad case fails because of its one change.
 TEST_F(HostileShot, BaseShotParses) {
   write("shot.toml", shot_text({}));
-  EXPECT_NO_THROW(emaki::io::load_shot(p("shot.toml")));
+  EXPECT_NO_THROW(emaki::shot::open(p("shot.toml")));
 }
 
 // ---- bad keys, table-driven ----
@@ -442,9 +443,9 @@ TEST_F(HostileShot, SequenceFrameOfAnotherSizeIsAnError) {
             std::regex("aa = 1\n|\\[source.camera\\]\n|\\[source.light\\]\n"
                        "direction = \\[0.3, 0.9, -0.3\\]\n|\\[source.ground\\]\n"),
             ""));
-  const emaki::pipeline::Shot shot = emaki::io::load_shot(p("shot.toml"));
+  const emaki::pipeline::Shot shot = emaki::shot::open(p("shot.toml"));
   EXPECT_EQ(shot.source.width, 8);
-  const auto frames = emaki::io::open_frames(shot);
+  const auto frames = emaki::shot::open_frames(shot);
   EXPECT_NO_THROW(frames->passes(0));
   try {
     frames->passes(1);

@@ -13,25 +13,11 @@
 #include "apps/emaki/frame_range.h"
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
-#include "core/limits.h"
-#include "core/parallel.h"
-#include "io/shot_file.h"
-#include "io/shot_inputs.h"
-#include "pipeline/flicker.h"
-#include "pipeline/run.h"
-#include "render/passes.h"
+#include "shot/shot.h"
 
 namespace emaki::app {
 
 namespace {
-
-// --frames is optional here: empty leaves the shot's whole range (first/last_frame < 0).
-void parse_frames(const std::string& text, pipeline::RunOptions& o) {
-  if (text.empty()) return;
-  const FrameRange r = parse_frame_range("--frames", text);
-  o.first_frame = r.first;
-  o.last_frame = r.last;
-}
 
 std::vector<std::string> split_commas(const std::string& text) {
   std::vector<std::string> out;
@@ -76,6 +62,38 @@ void end_progress_line() {
   if (::isatty(2)) std::fprintf(stderr, "\n");
 }
 
+// The options every shot command shares, bound to a shot::Request.
+struct ShotCommand {
+  std::string shot_path, frames, layers;
+  bool no_previews = false;
+  int threads = -1;
+
+  void bind(CLI::App& app, const char* frames_help) {
+    app.add_option("shot", shot_path, "the shot file (TOML; see docs/shot_file.md)")->required();
+    app.add_option("--frames", frames, frames_help);
+    app.add_option("--threads", threads,
+                   "worker threads, >= 0; 0 = all cores (default: the shot's)")
+        ->check(CLI::NonNegativeNumber);
+  }
+  void bind_previews(CLI::App& app) {
+    app.add_flag("--no-previews", no_previews, "do not write the contact sheet and the MP4");
+  }
+  // The request; --frames is optional: empty leaves the shot's whole range.
+  shot::Request request(const char* command) const {
+    shot::Request r;
+    if (!frames.empty()) {
+      const FrameRange range = parse_frame_range("--frames", frames);
+      r.first_frame = range.first;
+      r.last_frame = range.last;
+    }
+    r.layers = split_commas(layers);
+    r.previews = !no_previews;
+    r.threads = threads;
+    r.progress = progress_printer(command);
+    return r;
+  }
+};
+
 }  // namespace
 
 int run_run(const Args& args) {
@@ -84,43 +102,26 @@ int run_run(const Args& args) {
       "chain), composites them over the paper and writes the outputs the shot asks "
       "for. Re-running resumes after the last finished frame.",
       "emaki run"};
-  std::string shot_path, frames, layers;
-  bool force = false, no_previews = false;
-  int threads = -1;
-  app.add_option("shot", shot_path, "the shot file (TOML; see docs/shot_file.md)")->required();
-  app.add_option("--frames", frames, "FIRST-LAST or FRAME: only these frames (default: all)");
-  app.add_option("--layers", layers, "comma-separated layer names (default: all)");
+  ShotCommand c;
+  bool force = false;
+  c.bind(app, "FIRST-LAST or FRAME: only these frames (default: all)");
+  app.add_option("--layers", c.layers, "comma-separated layer names (default: all)");
   app.add_flag("--force", force,
                "synthesize again frames that are already finished (outputs made with other "
                "settings are always redone)");
-  app.add_flag("--no-previews", no_previews, "do not write the contact sheet and the MP4");
-  app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores (default: the shot's)")
-      ->check(CLI::NonNegativeNumber);
+  c.bind_previews(app);
   if (parse_cli(app, args)) return 0;
-
-  const pipeline::Shot shot = io::load_shot(shot_path);
-  set_thread_count(threads >= 0 ? threads : shot.threads);
-  pipeline::RunOptions options;
-  parse_frames(frames, options);
-  options.layers = split_commas(layers);
-  options.force = force;
-  options.progress = progress_printer("run");
-  // Everything that can fail on the inputs fails here, before a single output file exists.
-  const auto source = io::open_frames(shot);
-  const auto exemplars = io::load_exemplars(shot);
-  const pipeline::CompositeInputs ci = io::load_composite_inputs(shot);
-  io::FileStore store(shot);
-  const pipeline::RunReport r = pipeline::run_shot(shot, *source, exemplars, ci, store, options);
+  const pipeline::Shot shot = shot::open(c.shot_path);
+  shot::Request request = c.request("run");
+  request.force = force;
+  const shot::RunResult r = shot::run(shot, request);
   end_progress_line();
-  std::vector<std::string> previews;
-  if (!no_previews)
-    previews = io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
   std::fprintf(stderr,
                "emaki run: frames %d-%d: %d layer-frames synthesized, %d already finished, %d "
                "frames composited; outputs in %s\n",
-               r.first_frame, r.last_frame, r.synthesized, r.reused, r.composited,
-               shot.outputs.folder.c_str());
-  for (const std::string& p : previews) std::fprintf(stderr, "emaki run: wrote %s\n", p.c_str());
+               r.report.first_frame, r.report.last_frame, r.report.synthesized, r.report.reused,
+               r.report.composited, shot.outputs.folder.c_str());
+  for (const std::string& p : r.previews) std::fprintf(stderr, "emaki run: wrote %s\n", p.c_str());
   return 0;
 }
 
@@ -129,28 +130,14 @@ int run_composite(const Args& args) {
       "Re-composites a shot's finished layers with the colours, filters, blend modes "
       "and paper now in the shot file, without synthesizing again.",
       "emaki composite"};
-  std::string shot_path, frames;
-  bool no_previews = false;
-  int threads = -1;
-  app.add_option("shot", shot_path, "the shot file")->required();
-  app.add_option("--frames", frames, "FIRST-LAST or FRAME (default: all)");
-  app.add_flag("--no-previews", no_previews, "do not write the contact sheet and the MP4");
-  app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores")
-      ->check(CLI::NonNegativeNumber);
+  ShotCommand c;
+  c.bind(app, "FIRST-LAST or FRAME (default: all)");
+  c.bind_previews(app);
   if (parse_cli(app, args)) return 0;
-  const pipeline::Shot shot = io::load_shot(shot_path);
-  set_thread_count(threads >= 0 ? threads : shot.threads);
-  pipeline::RunOptions options;
-  parse_frames(frames, options);
-  options.progress = progress_printer("composite");
-  const auto source = io::open_frames(shot);
-  const pipeline::CompositeInputs ci = io::load_composite_inputs(shot);
-  // Layers made with other settings are an error here: re-colouring never synthesizes.
-  io::FileStore store(shot, io::StoreMode::kReadFinished);
-  const int n = pipeline::recomposite(shot, *source, ci, store, options);
+  const pipeline::Shot shot = shot::open(c.shot_path);
+  const shot::CompositeResult r = shot::composite(shot, c.request("composite"));
   end_progress_line();
-  if (!no_previews) io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
-  std::fprintf(stderr, "emaki composite: %d frames composited into %s\n", n,
+  std::fprintf(stderr, "emaki composite: %d frames composited into %s\n", r.composited,
                shot.outputs.folder.c_str());
   return 0;
 }
@@ -163,50 +150,26 @@ int run_qa(const Args& args) {
       "renderer's motion vectors over pixels visible in both frames, split into scene "
       "objects and ground. Prints a table and a JSON line.",
       "emaki qa flicker"};
-  std::string shot_path, frames, layer;
-  int threads = -1;
-  app.add_option("shot", shot_path, "the shot file")->required();
+  ShotCommand c;
+  std::string layer;
+  c.bind(app, "FIRST-LAST (default: all)");
   app.add_option("--layer", layer, "the layer to measure")->required();
-  app.add_option("--frames", frames, "FIRST-LAST (default: all)");
-  app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores")
-      ->check(CLI::NonNegativeNumber);
   if (parse_cli(app, Args(args.begin() + 1, args.end()))) return 0;
-  const pipeline::Shot shot = io::load_shot(shot_path);
-  set_thread_count(threads >= 0 ? threads : shot.threads);
-  const pipeline::Layer* l = shot.find_layer(layer);
-  if (!l) throw Error("--layer", fmt::format("no layer '{}' in the shot", layer));
-  pipeline::RunOptions o;
-  parse_frames(frames, o);
-  const int a = o.first_frame < 0 ? shot.source.first_frame : o.first_frame;
-  const int b = o.last_frame < 0 ? shot.source.last_frame : o.last_frame;
-  if (b <= a) throw Error("--frames", "needs at least two frames");
-  const auto source = io::open_frames(shot);
-  io::FileStore store(shot, io::StoreMode::kReadFinished);
-  for (int f = a; f <= b; ++f)
-    if (!store.has_layer(*l, f))
-      throw Error(fmt::format("layers.{}", layer),
-                  fmt::format("frame {} is not synthesized yet", f));
-  const int value_channels = l->single_colour ? 1 : 3;
+  const pipeline::Shot shot = shot::open(c.shot_path);
+  shot::Request request = c.request("qa");
+  request.progress = nullptr;
+  const shot::FlickerResult r = shot::flicker(shot, layer, request);
   std::printf("%-6s %12s %12s %12s %9s\n", "frame", "all", "objects", "ground", "pixels");
-  pipeline::SequenceFlicker mean;
-  Image<float> prev = store.read_layer(*l, a), prev_passes = source->passes(a);
-  for (int f = a + 1; f <= b; ++f) {
-    Image<float> cur = store.read_layer(*l, f), cur_passes = source->passes(f);
-    const int mask_channel = cur.channels() > value_channels ? value_channels : -1;
-    const pipeline::FrameFlicker ff = pipeline::frame_flicker(
-        cur.cview(), prev.cview(), cur_passes.cview(), prev_passes.cview(), mask_channel);
-    std::printf("%-6d %12.5f %12.5f %12.5f %9ld\n", f, ff.all.mean(), ff.objects.mean(),
-                ff.ground.mean(), ff.all.pixels);
-    mean.add(ff);
-    prev = std::move(cur);
-    prev_passes = std::move(cur_passes);
-  }
-  std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", mean.all.mean(), mean.objects.mean(),
-              mean.ground.mean());
+  for (const pipeline::FrameFlicker& f : r.frames)
+    std::printf("%-6d %12.5f %12.5f %12.5f %9ld\n", f.frame, f.all.mean(), f.objects.mean(),
+                f.ground.mean(), f.all.pixels);
+  const pipeline::SequenceFlicker& m = r.mean;
+  std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", m.all.mean(), m.objects.mean(),
+              m.ground.mean());
   std::printf(
       "{\"layer\": \"%s\", \"frames\": [%d, %d], \"mean\": %.6f, \"objects\": %.6f, "
       "\"ground\": %.6f}\n",
-      layer.c_str(), a, b, mean.all.mean(), mean.objects.mean(), mean.ground.mean());
+      layer.c_str(), r.first_frame, r.last_frame, m.all.mean(), m.objects.mean(), m.ground.mean());
   return 0;
 }
 

@@ -40,6 +40,7 @@ constexpr FieldOption kFieldOptions[] = {
     {"frames", "--frames"}, {"fps", "--fps"},         {"clip", "--clip"},
     {"start", "--start"},   {"aa", "--aa"},           {"gltf_node", "--gltf-camera"},
     {"sphere", "--sphere"}, {"horizon", "--horizon"}, {"layers", "--layers"},
+    {"layer", "--layer"},
 };
 
 std::string error_text(const emaki::Error& e) {

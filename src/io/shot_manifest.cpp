@@ -60,8 +60,10 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
   } else {
     // A sequence's frames are not hashed (they may be gigabytes): its pattern and conventions.
     l.add("source.sequence", s.pattern);
-    l.add("source.preset", fmt::format("{} {} world_normals {} z_up {} premultiplied {}", s.preset,
-                                       s.view_layer, s.world_normals, s.z_up, s.premultiplied));
+    l.add("source.preset",
+          fmt::format("{} {} world_normals {} z_up {} premultiplied {}",
+                      s.preset == pipeline::SourcePreset::kBlender ? "blender" : "emaki",
+                      s.view_layer, s.world_normals, s.z_up, s.premultiplied));
     for (const pipeline::ChannelMapping& m : s.channels)
       l.add("source.channels." + m.pass, fmt::format("{}", fmt::join(m.channels, " ")));
   }

@@ -1,8 +1,11 @@
 #include "pipeline/flicker.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "core/check.h"
+#include "core/error.h"
 #include "render/passes.h"
 
 namespace emaki::pipeline {
@@ -43,6 +46,30 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
       s.sum += e, ++s.pixels;
     }
   return out;
+}
+
+SequenceFlicker measure_flicker(const Layer& layer, const FrameSource& frames, const Store& store,
+                                int first, int last,
+                                const std::function<void(const FrameFlicker&)>& each) {
+  CHECK_LT(first, last);
+  for (int f = first; f <= last; ++f)
+    if (!store.has_layer(layer, f))
+      throw Error("layers." + layer.name, fmt::format("frame {} is not synthesized yet", f));
+  const int value_channels = layer.single_colour ? 1 : 3;
+  SequenceFlicker mean;
+  Image<float> prev = store.read_layer(layer, first), prev_passes = frames.passes(first);
+  for (int f = first + 1; f <= last; ++f) {
+    Image<float> cur = store.read_layer(layer, f), cur_passes = frames.passes(f);
+    const int mask_channel = cur.channels() > value_channels ? value_channels : -1;
+    FrameFlicker ff = frame_flicker(cur.cview(), prev.cview(), cur_passes.cview(),
+                                    prev_passes.cview(), mask_channel);
+    ff.frame = f;
+    if (each) each(ff);
+    mean.add(ff);
+    prev = std::move(cur);
+    prev_passes = std::move(cur_passes);
+  }
+  return mean;
 }
 
 }  // namespace emaki::pipeline

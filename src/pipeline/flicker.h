@@ -3,7 +3,12 @@
 // vectors say the same surface point was, over pixels visible in both frames.
 #pragma once
 
+#include <functional>
+
 #include "core/image.h"
+#include "pipeline/frames.h"
+#include "pipeline/run.h"
+#include "pipeline/shot.h"
 
 namespace emaki::pipeline {
 
@@ -35,5 +40,12 @@ struct SequenceFlicker {
 FrameFlicker frame_flicker(ImageView<const float> current, ImageView<const float> previous,
                            ImageView<const float> current_passes,
                            ImageView<const float> previous_passes, int mask_channel);
+
+// The flicker of `layer`'s finished frames [first, last] (first < last) in `store`, with the
+// passes of `frames`; `each` (may be empty) sees each frame's figures in frame order. Throws
+// emaki::Error naming the layer ("layers.NAME") when a frame is not synthesized yet.
+SequenceFlicker measure_flicker(const Layer& layer, const FrameSource& frames, const Store& store,
+                                int first, int last,
+                                const std::function<void(const FrameFlicker&)>& each);
 
 }  // namespace emaki::pipeline

@@ -1,6 +1,6 @@
 // A shot, as the shot file describes it (docs/shot_file.md is the table of every key): where
 // the guide passes come from, the exemplars, the layers and how they are composited, and what
-// is written. Plain data, free of I/O: io/shot_file.cpp fills it, pipeline/ runs it.
+// is written. Plain data, free of I/O: shot/shot_file.cpp fills it, pipeline/ runs it.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +17,12 @@ namespace emaki::pipeline {
 enum class SourceKind {
   kScene,     // a glTF scene rendered by emaki's own renderer
   kSequence,  // a studio render: one multilayer EXR per frame
+};
+
+// How a sequence's channels are named and what they mean.
+enum class SourcePreset {
+  kEmaki,    // emaki's names and conventions, as `emaki render` and the Blender exporter write
+  kBlender,  // a plain Cycles render, converted (io/studio_passes.h)
 };
 
 // One pass of passes.h read from a studio render's channels.
@@ -36,13 +42,10 @@ struct Source {
   render::RenderOptions render;  // width/height mirror the source's size
   // kSequence
   std::string pattern;  // printf-style with one integer, e.g. renders/frame_%04d.exr
-  std::vector<ChannelMapping> channels;  // passes read under other names than emaki's
-  // How the file's channels are named and what they mean: "emaki" (emaki's names and
-  // conventions, as `emaki render` and tools/blender/emaki_passes.py write them) or "blender"
-  // (a plain Cycles render, converted: io/studio_passes.h). `channels` overrides either.
-  std::string preset = "emaki";
-  std::string view_layer = "ViewLayer";  // "blender": the view layer's channel prefix
-  // "emaki" preset, for other renderers' AOVs: conventions converted on reading.
+  std::vector<ChannelMapping> channels;        // passes read under other names than emaki's
+  SourcePreset preset = SourcePreset::kEmaki;  // `channels` overrides either preset
+  std::string view_layer = "ViewLayer";        // kBlender: the view layer's channel prefix
+  // kEmaki preset, for other renderers' AOVs: conventions converted on reading.
   bool world_normals = false;  // normal is world-space (turned into camera space)
   bool z_up = false;           // position (and world normals) are Z-up
   bool premultiplied = false;  // continuous passes are premultiplied by alpha
@@ -103,10 +106,13 @@ struct SynthSpec {
   uint64_t seed = 1;
 };
 
+// What a layer is for: sets its defaults (shot/kinds.h).
+enum class LayerKind { kBase, kOutline, kShadow, kCustom };
+
 struct Layer {
   std::string name;
-  std::string kind = "custom";  // base, outline, shadow or custom: sets the defaults
-  std::string exemplar;         // an Exemplar's name
+  LayerKind kind = LayerKind::kCustom;
+  std::string exemplar;  // an Exemplar's name
   std::vector<GuideSpec> guides;
   SynthSpec synth;
   bool single_colour = true;

@@ -15,6 +15,7 @@
 //     where the layer's mask is the covered pixels (layers named base*). Exits 1 otherwise.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -23,8 +24,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/frame_sequence.h"
 #include "io/image_io.h"
-#include "io/shot_inputs.h"
 #include "render/passes.h"
 
 namespace {
@@ -35,7 +36,10 @@ namespace render = emaki::render;
 Image<float> load(const std::string& arg) {
   const std::size_t colon = arg.rfind(':');
   if (colon != std::string::npos && colon > 0 && arg.find('/', colon) == std::string::npos)
-    return emaki::io::read_pass_file(arg.substr(0, colon), arg.substr(colon + 1));
+    return emaki::io::read_pass_file(arg.substr(0, colon),
+                                     arg.substr(colon + 1) == "blender"
+                                         ? emaki::pipeline::SourcePreset::kBlender
+                                         : emaki::pipeline::SourcePreset::kEmaki);
   return emaki::io::read_pass_file(arg);
 }
 

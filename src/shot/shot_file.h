@@ -1,7 +1,7 @@
-// The shot file: TOML (toml++) into a pipeline::Shot. Every key is documented in
-// docs/shot_file.md; a key that nothing reads is an error with a "did you mean" suggestion, and
-// every error names its key path (e.g. "layers.outline.wieght: unknown key — did you mean
-// 'weight'?"). Relative paths are resolved against the shot file's folder.
+// The shot file: TOML (toml++) into a pipeline::Shot. Every key is in the schema (shot/schema.h;
+// docs/shot_file.md is made from it); a key that nothing reads is an error with a "did you mean"
+// suggestion, and every error names its key path (e.g. "layers.outline.wieght: unknown key — did
+// you mean 'weight'?"). Relative paths are resolved against the shot file's folder.
 #pragma once
 
 #include <cstddef>
@@ -11,7 +11,7 @@
 
 #include "pipeline/shot.h"
 
-namespace emaki::io {
+namespace emaki::shot {
 
 // A shot file is a page of text: larger files and deeper nesting are refused before toml++
 // parses them (its parser recurses per level; see docs/shot_file.md, "Limits").
@@ -27,9 +27,4 @@ pipeline::Shot load_shot(const std::string& path);
 // The same from text (`path` is used for messages and to resolve relative paths).
 pipeline::Shot parse_shot(std::string_view text, const std::string& path);
 
-// Levenshtein edit distance, and the closest of `candidates` to `key` if it is close enough to
-// be a likely typo (empty otherwise).
-int edit_distance(std::string_view a, std::string_view b);
-std::string closest_key(std::string_view key, const std::vector<std::string>& candidates);
-
-}  // namespace emaki::io
+}  // namespace emaki::shot

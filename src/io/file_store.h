@@ -1,7 +1,6 @@
-// The file side of running a shot: the frames of its source (rendered from a glTF scene, or
-// read from a studio render's EXR sequence), its exemplars and paper, and the Store that keeps
-// layer results and per-frame outputs in the output folder (every write atomic), plus the
-// previews made at the end (contact sheet, MP4 through ffmpeg).
+// The output folder of a shot: its layout (OutputPaths) and the Store that keeps layer results
+// and per-frame outputs there, every write atomic, each set of files under a manifest of the
+// settings that made it (io/shot_manifest.h).
 #pragma once
 
 #include <map>
@@ -10,38 +9,17 @@
 #include <vector>
 
 #include "io/output_store.h"
-#include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "pipeline/shot.h"
-#include "render/passes.h"
 
 namespace emaki::io {
 
-// The widest frame number a pattern may ask for (%012d): wider is refused, never padded.
-inline constexpr int kMaxFrameWidth = 12;
+// What an error about stale outputs tells the user to do.
+inline constexpr const char* kRedoHint =
+    "run `emaki run` to redo it (`emaki run --force` redoes everything)";
 
-// The file of frame `frame` of a printf-style pattern ("frame_%04d.exr"); the pattern holds %d
-// or %0Nd only (the shot file checks it), and a width over kMaxFrameWidth throws.
-std::string frame_file(const std::string& pattern, int frame);
-
-// The channel names a sequence source reads for `pass` (its mapping, or emaki's own names).
-std::vector<std::string> source_channels(const pipeline::Source& source,
-                                         const render::PassInfo& pass);
-
-// One pass file as emaki's frame (render::kChannelCount channels): `preset` "emaki" reads
-// emaki's channel names (a single-channel pass also as NAME.V, as the Blender exporter writes
-// it); "blender" converts a plain Blender render of view layer `view_layer`, position_norm's
-// cube taken from this frame alone.
-Image<float> read_pass_file(const std::string& file, const std::string& preset = "emaki",
-                            const std::string& view_layer = "ViewLayer");
-
-// The shot's frames. Errors name the shot file's keys (source.scene, source.clip, ...).
-std::unique_ptr<pipeline::FrameSource> open_frames(const pipeline::Shot& shot);
-
-// Every exemplar's painting and guide passes; errors name exemplars.NAME.*.
-std::map<std::string, pipeline::ExemplarImages> load_exemplars(const pipeline::Shot& shot);
-
-pipeline::CompositeInputs load_composite_inputs(const pipeline::Shot& shot);
+// The file beside a layer's (or the composites') frames naming the settings that made them.
+inline constexpr const char* kManifest = ".emaki-manifest";
 
 // The output folder's layout.
 struct OutputPaths {
@@ -93,12 +71,5 @@ class FileStore : public pipeline::Store {
   std::map<std::string, Manifested> layers_;
   Manifested frames_;
 };
-
-// The contact sheet and the MP4 preview of the composited frames [first, last] (each when the
-// shot's outputs ask for it). Returns the files written.
-std::vector<std::string> write_previews(const pipeline::Shot& shot, int first, int last);
-
-// Encodes `pattern` (printf-style) frames [first, ...] into an H.264 MP4 with the ffmpeg binary.
-void encode_mp4(const std::string& pattern, int first, float fps, int crf, const std::string& out);
 
 }  // namespace emaki::io

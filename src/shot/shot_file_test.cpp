@@ -1,12 +1,13 @@
-#include "io/shot_file.h"
+#include "shot/shot_file.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
 #include "core/error.h"
+#include "shot/toml_reader.h"
 
-namespace emaki::io {
+namespace emaki::shot {
 namespace {
 
 const std::string kData = EMAKI_TEST_DATA;
@@ -125,4 +126,4 @@ TEST(ShotFile, ChannelPresetKeysAreChecked) {
 }
 
 }  // namespace
-}  // namespace emaki::io
+}  // namespace emaki::shot

@@ -1,0 +1,23 @@
+// A shot's inputs, opened: its frames (rendered from a glTF scene, or read from a studio render's
+// EXR sequence), its exemplars' paintings and guide passes, and the paper. Errors from the
+// loaders below name the shot file's keys (source.clip, exemplars.NAME.sphere, ...).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "pipeline/frames.h"
+#include "pipeline/run.h"
+#include "pipeline/shot.h"
+
+namespace emaki::shot {
+
+std::unique_ptr<pipeline::FrameSource> open_frames(const pipeline::Shot& shot);
+
+// Every exemplar's painting and guide passes; errors name exemplars.NAME.*.
+std::map<std::string, pipeline::ExemplarImages> load_exemplars(const pipeline::Shot& shot);
+
+pipeline::CompositeInputs load_composite_inputs(const pipeline::Shot& shot);
+
+}  // namespace emaki::shot

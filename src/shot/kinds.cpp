@@ -1,0 +1,32 @@
+#include "shot/kinds.h"
+
+namespace emaki::shot {
+
+KindDefaults kind_defaults(pipeline::LayerKind kind) {
+  KindDefaults d;
+  switch (kind) {
+    case pipeline::LayerKind::kBase:
+      d.guides = {{"normal", 1.0f}, {"diffuse", 1.0f}};
+      d.mask = {pipeline::MaskKind::kCovered, 0.0f, 0.5f};
+      d.look.source = composite::ColorSource::kAlbedo;
+      break;
+    case pipeline::LayerKind::kShadow:
+      d.guides = {{"diffuse", 1.0f}, {"shadow", 1.0f}};
+      d.mask = {pipeline::MaskKind::kShadow, 2.0f, 0.5f};
+      d.look.flat = {0.55f, 0.52f, 0.7f};
+      d.look.blend = composite::BlendMode::kMultiply;
+      break;
+    case pipeline::LayerKind::kOutline:
+      d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};
+      d.mask = {pipeline::MaskKind::kLines, 3.0f, 0.1f};
+      d.look.flat = {0.08f, 0.06f, 0.06f};
+      d.look.alpha_from = composite::AlphaFrom::kInverseValue;
+      d.temporal_weight = 0.5f;
+      break;
+    case pipeline::LayerKind::kCustom:
+      break;
+  }
+  return d;
+}
+
+}  // namespace emaki::shot

@@ -1,0 +1,22 @@
+// The parts of the shot file parser (shot_file.cpp reads the top level and calls these). Internal
+// to the shot module.
+#pragma once
+
+#include <string>
+
+#include "pipeline/shot.h"
+#include "shot/toml_reader.h"
+
+namespace emaki::shot {
+
+// [source]: a glTF scene or a studio render's EXR sequence (whose first frame is opened to check
+// its channels and take its size).
+void parse_source(const Reader& r, const PathContext& ctx, pipeline::Source& s);
+
+// [exemplars.NAME]
+void parse_exemplar(const Reader& r, const PathContext& ctx, pipeline::Exemplar& e);
+
+// [layers.NAME]; its exemplar must be one of shot.exemplars.
+void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l);
+
+}  // namespace emaki::shot

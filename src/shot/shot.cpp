@@ -1,0 +1,93 @@
+#include "shot/shot.h"
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "core/limits.h"
+#include "core/parallel.h"
+#include "io/file_store.h"
+#include "io/previews.h"
+#include "shot/inputs.h"
+#include "shot/shot_file.h"
+
+namespace emaki::shot {
+
+namespace {
+
+pipeline::RunOptions run_options(const Request& r) {
+  pipeline::RunOptions o;
+  o.first_frame = r.first_frame;
+  o.last_frame = r.last_frame;
+  o.layers = r.layers;
+  o.force = r.force;
+  o.progress = r.progress;
+  return o;
+}
+
+void use_threads(const pipeline::Shot& shot, const Request& r) {
+  set_thread_count(r.threads >= 0 ? r.threads : shot.threads);
+}
+
+std::vector<std::string> previews(const pipeline::Shot& shot, const Request& r) {
+  if (!r.previews) return {};
+  return io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
+}
+
+}  // namespace
+
+pipeline::Shot open(const std::string& path) {
+  return load_shot(path);
+}
+
+pipeline::Shot open_text(std::string_view text, const std::string& path) {
+  return parse_shot(text, path);
+}
+
+RunResult run(const pipeline::Shot& shot, const Request& request) {
+  use_threads(shot, request);
+  // Everything that can fail on the inputs fails here, before a single output file exists.
+  const auto frames = open_frames(shot);
+  const auto exemplars = load_exemplars(shot);
+  const pipeline::CompositeInputs ci = load_composite_inputs(shot);
+  RunResult out;
+  io::FileStore store(shot);  // holds the folder's lock until the previews are written
+  out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request));
+  out.previews = previews(shot, request);
+  return out;
+}
+
+CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
+  use_threads(shot, request);
+  const auto frames = open_frames(shot);
+  const pipeline::CompositeInputs ci = load_composite_inputs(shot);
+  CompositeResult out;
+  // Layers made with other settings are an error here: re-colouring never synthesizes.
+  io::FileStore store(shot, io::StoreMode::kReadFinished);
+  out.composited = pipeline::recomposite(shot, *frames, ci, store, run_options(request));
+  out.previews = previews(shot, request);
+  return out;
+}
+
+FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,
+                      const Request& request) {
+  use_threads(shot, request);
+  const pipeline::Layer* l = shot.find_layer(layer);
+  if (!l) throw Error(Error::Field{"layer"}, fmt::format("no layer '{}' in the shot", echo(layer)));
+  FlickerResult out;
+  out.first_frame = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
+  out.last_frame = request.last_frame < 0 ? shot.source.last_frame : request.last_frame;
+  if (out.last_frame <= out.first_frame)
+    throw Error(Error::Field{"frames"}, "needs at least two frames");
+  if (out.first_frame < shot.source.first_frame || out.last_frame > shot.source.last_frame)
+    throw Error(Error::Field{"frames"},
+                fmt::format("{}-{} is outside the shot's frames {}-{}", out.first_frame,
+                            out.last_frame, shot.source.first_frame, shot.source.last_frame));
+  const auto frames = open_frames(shot);
+  io::FileStore store(shot, io::StoreMode::kReadFinished);
+  out.mean =
+      pipeline::measure_flicker(*l, *frames, store, out.first_frame, out.last_frame,
+                                [&](const pipeline::FrameFlicker& f) { out.frames.push_back(f); });
+  return out;
+}
+
+}  // namespace emaki::shot

@@ -1,0 +1,61 @@
+// The shot API: the one surface every front end (the CLI, the farm submitter, the Python module)
+// drives. open() reads and checks a shot file; run(), composite() and flicker() open its inputs,
+// lock its output folder and do the work. Errors are emaki::Error: a shot file's problems name
+// its key ("layers.outline.mask"); a Request's name neutral fields ("frames", "layers",
+// "layer", "threads") that each front end spells its own way (--frames, frames=).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pipeline/flicker.h"
+#include "pipeline/run.h"
+#include "pipeline/shot.h"
+
+namespace emaki::shot {
+
+// Reads and checks a shot file (shot/shot_file.h): nothing is written.
+pipeline::Shot open(const std::string& path);
+// The same from text; `path` names it in errors and anchors relative paths.
+pipeline::Shot open_text(std::string_view text, const std::string& path);
+
+// Which part of a shot to work on, and how.
+struct Request {
+  int first_frame = -1, last_frame = -1;  // -1: the shot's range (field "frames")
+  std::vector<std::string> layers;        // empty: every layer (field "layers")
+  bool force = false;                     // run: synthesize finished frames again
+  bool previews = true;                   // contact sheet and MP4, as the shot's outputs ask
+  int threads = -1;                       // -1: the shot's `threads`; 0: all cores
+  std::function<void(const pipeline::Progress&)> progress;
+};
+
+struct RunResult {
+  pipeline::RunReport report;
+  std::vector<std::string> previews;  // files written
+};
+
+// Synthesizes, composites and writes the requested frames and layers, resuming after the last
+// finished frame. Every input is opened and checked before the first output is written.
+RunResult run(const pipeline::Shot& shot, const Request& request);
+
+struct CompositeResult {
+  int composited = 0;  // frames
+  std::vector<std::string> previews;
+};
+
+// Re-composites finished layers with the shot's current colours, blends and paper; layers made
+// with other settings are an error naming the layer folder.
+CompositeResult composite(const pipeline::Shot& shot, const Request& request);
+
+struct FlickerResult {
+  int first_frame = 0, last_frame = 0;
+  std::vector<pipeline::FrameFlicker> frames;  // first_frame + 1 .. last_frame
+  pipeline::SequenceFlicker mean;
+};
+
+// The temporal error of a finished layer (field "layer" names it) over at least two frames.
+FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer, const Request& request);
+
+}  // namespace emaki::shot
