@@ -344,4 +344,10 @@ Image<float> contact_sheet(const std::vector<Image<float>>& frames, int columns,
   return sheet;
 }
 
+void check_run_options(const Shot& shot, const RunOptions& options) {
+  int a = 0, b = 0;
+  resolve_range(shot, options, a, b);
+  (void)selected_layers(shot, options.layers);
+}
+
 }  // namespace emaki::pipeline

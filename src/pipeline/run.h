@@ -75,6 +75,10 @@ RunReport run_shot(const Shot& shot, const FrameSource& frames,
                    const CompositeInputs& composite_inputs, Store& store,
                    const RunOptions& options);
 
+// Throws what run_shot would throw for `options` alone (fields "layers" and "frames"), so that a
+// front end can refuse a request before it creates an output file.
+void check_run_options(const Shot& shot, const RunOptions& options);
+
 // Re-composites finished layer frames with the shot's current colours, blends and paper,
 // without synthesizing. Returns the number of frames written.
 int recomposite(const Shot& shot, const FrameSource& frames,

@@ -44,6 +44,7 @@ pipeline::Shot open_text(std::string_view text, const std::string& path) {
 }
 
 RunResult run(const pipeline::Shot& shot, const Request& request) {
+  pipeline::check_run_options(shot, run_options(request));
   use_threads(shot, request);
   // Everything that can fail on the inputs fails here, before a single output file exists.
   const auto frames = open_frames(shot);
@@ -57,6 +58,7 @@ RunResult run(const pipeline::Shot& shot, const Request& request) {
 }
 
 CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
+  pipeline::check_run_options(shot, run_options(request));
   use_threads(shot, request);
   const auto frames = open_frames(shot);
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);

@@ -1,0 +1,94 @@
+// The shot API as every front end calls it: run, composite and flicker on a tiny shot, and the
+// neutral field names of a Request's errors.
+#include "shot/shot.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "core/error.h"
+
+namespace emaki::shot {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kData = EMAKI_TEST_DATA;
+
+class ShotApi : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ =
+        fs::temp_directory_path() /
+        ("emaki_shot_api_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(folder_);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  pipeline::Shot tiny() const {
+    const std::string text =
+        "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nclip = \"Walk\"\n" +
+        "frames = [0, 2]\nsize = [40, 24]\naa = 1\n[exemplars.sphere]\npainting = \"" + kData +
+        "/stylit/source_style.png\"\n[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n" +
+        "[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\ntemporal = false\n" +
+        "[outputs]\nfolder = \"" + folder_.string() + "\"\nmp4 = false\n";
+    return open_text(text, (folder_.parent_path() / "tiny.toml").string());
+  }
+
+  fs::path folder_;
+};
+
+TEST_F(ShotApi, RunResumesAndComposites) {
+  const pipeline::Shot shot = tiny();
+  Request r;
+  int progress_calls = 0;
+  r.progress = [&](const pipeline::Progress&) { ++progress_calls; };
+  const RunResult first = run(shot, r);
+  EXPECT_EQ(first.report.synthesized, 6);
+  EXPECT_EQ(first.report.composited, 3);
+  EXPECT_GT(progress_calls, 0);
+  ASSERT_EQ(first.previews.size(), 1u);  // the contact sheet (mp4 = false)
+  EXPECT_TRUE(fs::exists(first.previews[0]));
+  const RunResult again = run(shot, Request{});
+  EXPECT_EQ(again.report.synthesized, 0);
+  EXPECT_EQ(again.report.reused, 6);
+  Request two;
+  two.first_frame = 1, two.last_frame = 2, two.previews = false;
+  EXPECT_EQ(composite(shot, two).composited, 2);
+  const FlickerResult f = flicker(shot, "base", Request{});
+  ASSERT_EQ(f.frames.size(), 2u);
+  EXPECT_EQ(f.frames[0].frame, 1);
+  EXPECT_GT(f.mean.all.mean(), 0.0);
+}
+
+Error error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error";
+  return Error("", "");
+}
+
+// A Request's errors name neutral fields that each front end spells its own way.
+TEST_F(ShotApi, RequestErrorsNameNeutralFields) {
+  const pipeline::Shot shot = tiny();
+  Request unknown;
+  unknown.layers = {"nope"};
+  EXPECT_EQ(error_of([&] { run(shot, unknown); }).field(), "layers");
+  Request outside;
+  outside.first_frame = 0, outside.last_frame = 9;
+  EXPECT_EQ(error_of([&] { run(shot, outside); }).field(), "frames");
+  EXPECT_FALSE(fs::exists(folder_));  // refused before anything was written
+  EXPECT_EQ(error_of([&] { flicker(shot, "nope", Request{}); }).field(), "layer");
+  Request one;
+  one.first_frame = one.last_frame = 1;
+  EXPECT_EQ(error_of([&] { flicker(shot, "base", one); }).field(), "frames");
+  // Nothing was synthesized: flicker names the layer by its shot key.
+  EXPECT_EQ(error_of([&] { flicker(shot, "base", Request{}); }).subject(), "layers.base");
+}
+
+}  // namespace
+}  // namespace emaki::shot
