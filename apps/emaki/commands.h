@@ -15,6 +15,9 @@ int run_template(const Args& args);
 int run_run(const Args& args);
 int run_composite(const Args& args);
 int run_qa(const Args& args);
+int run_plan(const Args& args);
+int run_farm(const Args& args);
+int run_task(const Args& args);
 
 struct Command {
   const char* name;

@@ -23,6 +23,9 @@ const std::vector<Command>& commands() {
        run_run},
       {"composite", "re-colour a shot's finished layers without synthesizing again", run_composite},
       {"qa", "quality checks: 'emaki qa flicker SHOT --layer NAME'", run_qa},
+      {"plan", "shots as a task graph for a render farm (a table, or --json)", run_plan},
+      {"farm", "run shots on Slurm: 'emaki farm submit|status|cancel SHOT...'", run_farm},
+      {"task", "one task of a plan, as a farm node runs it", run_task},
   };
   return list;
 }
@@ -40,7 +43,8 @@ constexpr FieldOption kFieldOptions[] = {
     {"frames", "--frames"}, {"fps", "--fps"},         {"clip", "--clip"},
     {"start", "--start"},   {"aa", "--aa"},           {"gltf_node", "--gltf-camera"},
     {"sphere", "--sphere"}, {"horizon", "--horizon"}, {"layers", "--layers"},
-    {"layer", "--layer"},
+    {"layer", "--layer"},   {"chunk", "--chunk"},     {"threads", "--threads"},
+    {"shots", "SHOT"},
 };
 
 std::string error_text(const emaki::Error& e) {

@@ -5,10 +5,12 @@
 #include <filesystem>
 #include <initializer_list>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/image_io.h"
 #include "io/shot_manifest.h"
+#include "render/passes.h"
 
 namespace emaki::io {
 
@@ -35,6 +37,9 @@ std::string OutputPaths::mp4() const {
 }
 std::string OutputPaths::contact_sheet() const {
   return folder + "/contact_sheet.png";
+}
+std::string OutputPaths::passes_exr(int frame) const {
+  return fmt::format("{}/passes/frame_{:04d}.exr", folder, frame);
 }
 
 namespace {
@@ -94,40 +99,132 @@ std::vector<std::string> value_names(const std::string& prefix, int channels, in
 
 }  // namespace
 
-FileStore::FileStore(const Shot& shot, StoreMode mode) : shot_(shot), mode_(mode) {
+FileStore::Manifested FileStore::manifested(const std::string& dir, Manifest want,
+                                            const std::string& prefix,
+                                            std::initializer_list<const char*> exts) {
+  FileStore::Manifested m;
+  m.want = std::move(want);
+  const auto have = read_manifest((fs::path(dir) / kManifest).string());
+  m.current = have && *have == m.want;
+  if (!m.current)
+    m.stale = have                           ? manifest_difference(*have, m.want)
+              : any_frame(dir, prefix, exts) ? "no record of the settings that made it"
+                                             : "";
+  return m;
+}
+
+FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
+    : shot_(shot), mode_(mode), access_(access) {
   paths_.folder = shot.outputs.folder;
   const fs::path root(paths_.folder);
+  if (access == StoreAccess::kInspect) {
+    for (const pipeline::Layer& l : shot.layers)
+      layers_[l.name] = manifested((root / "layers" / l.name).string(), layer_manifest(shot, l),
+                                   l.name + "_", {".png", ".exr"});
+    frames_ = manifested((root / "composite").string(), frames_manifest(shot), "frame_",
+                         {".png", ".exr"});
+    passes_ = manifested((root / "passes").string(), passes_manifest(shot), "frame_", {".exr"});
+    return;
+  }
   make_folder(root);
   // Before anything is cleaned up or written: another emaki's temporaries are not ours to remove.
-  lock_ = std::make_unique<FolderLock>(paths_.folder);
-  remove_temporaries(root.string(), [](const std::string& t) {
-    return t == "contact_sheet.png" || t == "preview.mp4";
-  });
+  lock_ = std::make_unique<FolderLock>(paths_.folder, access == StoreAccess::kFarmTask
+                                                          ? FolderLock::Kind::kShared
+                                                          : FolderLock::Kind::kExclusive);
+  // Farm tasks run beside each other: a temporary here may be another task's file in flight.
+  const bool clean = access == StoreAccess::kAlone;
+  auto clean_up = [clean](const fs::path& dir, const std::function<bool(const std::string&)>& f) {
+    if (clean) remove_temporaries(dir.string(), f);
+  };
+  clean_up(root,
+           [](const std::string& t) { return t == "contact_sheet.png" || t == "preview.mp4"; });
   for (const char* sub : {"composite", "layered"}) {
     make_folder(root / sub);
-    remove_temporaries((root / sub).string(), [](const std::string& t) {
+    clean_up(root / sub, [](const std::string& t) {
       return t == kManifest || is_frame_name(t, "frame_", {".png", ".exr"});
     });
   }
   for (const pipeline::Layer& l : shot.layers) {
     const fs::path dir = root / "layers" / l.name;
     make_folder(dir);
-    remove_temporaries(dir.string(), [&](const std::string& t) {
+    clean_up(dir, [&](const std::string& t) {
       return t == kManifest || is_frame_name(t, l.name + "_", {".png", ".exr"});
     });
-    Manifested& m = layers_[l.name];
-    m.want = layer_manifest(shot, l);
-    const auto have = read_manifest((dir / kManifest).string());
-    m.current = have && *have == m.want;
-    if (!m.current)
-      m.stale = have ? manifest_difference(*have, m.want)
-                : any_frame(dir, l.name + "_", {".png", ".exr"})
-                    ? "no record of the settings that made it"
-                    : "";
+    layers_[l.name] =
+        manifested(dir.string(), layer_manifest(shot, l), l.name + "_", {".png", ".exr"});
   }
-  frames_.want = frames_manifest(shot);
-  const auto have = read_manifest((root / "composite" / kManifest).string());
-  frames_.current = have && *have == frames_.want;
+  frames_ =
+      manifested((root / "composite").string(), frames_manifest(shot), "frame_", {".png", ".exr"});
+  // The pass cache exists only where the farm made one.
+  const fs::path cache = root / "passes";
+  std::error_code ec;
+  if (fs::is_directory(cache, ec)) {
+    clean_up(cache, [](const std::string& t) {
+      return t == kManifest || is_frame_name(t, "frame_", {".exr"});
+    });
+  }
+  passes_ = manifested(cache.string(), passes_manifest(shot), "frame_", {".exr"});
+}
+
+void FileStore::make_current(Manifested& m, const std::string& folder,
+                             const std::function<void(const std::string&)>& remove_frames_in) {
+  if (m.current) return;
+  CHECK(access_ != StoreAccess::kInspect);
+  if (access_ == StoreAccess::kFarmTask)
+    throw Error(folder, fmt::format("is not prepared for these settings{}; the shot's prepare "
+                                    "task (`emaki task prepare`) must run first",
+                                    m.stale.empty() ? "" : " (" + m.stale + ")"));
+  // Made with other settings: its old frames go before the new settings are recorded, so a run
+  // killed in between leaves no old frame under a new manifest.
+  const fs::path dir(folder);
+  std::error_code ec;
+  fs::remove(dir / kManifest, ec);
+  remove_frames_in(folder);
+  write_manifest((dir / kManifest).string(), m.want);
+  m.current = true;
+  m.stale.clear();
+}
+
+void FileStore::prepare() {
+  CHECK(mode_ == StoreMode::kRun);
+  const fs::path root(paths_.folder);
+  for (const pipeline::Layer& l : shot_.layers)
+    make_current(layers_.at(l.name), (root / "layers" / l.name).string(),
+                 [&](const std::string& dir) {
+                   remove_frames(dir, l.name + "_", {".png", ".exr"});
+                 });
+  make_current(frames_, (root / "composite").string(), [&](const std::string&) {
+    remove_frames(root / "composite", "frame_", {".png", ".exr"});
+    remove_frames(root / "layered", "frame_", {".exr"});
+  });
+  if (shot_.source.kind == pipeline::SourceKind::kScene) {
+    make_folder(root / "passes");
+    make_current(passes_, (root / "passes").string(),
+                 [](const std::string& dir) { remove_frames(dir, "frame_", {".exr"}); });
+  }
+}
+
+bool FileStore::prepared() const {
+  for (const auto& [name, m] : layers_)
+    if (!m.current) return false;
+  return frames_.current && (passes_.current || shot_.source.kind != pipeline::SourceKind::kScene);
+}
+
+bool FileStore::has_passes(int frame) const {
+  std::error_code ec;
+  return passes_.current && fs::is_regular_file(paths_.passes_exr(frame), ec);
+}
+
+void FileStore::write_passes(int frame, ImageView<const float> passes) {
+  CHECK(access_ != StoreAccess::kInspect);
+  const fs::path dir = fs::path(paths_.folder) / "passes";
+  make_folder(dir);
+  make_current(passes_, dir.string(),
+               [](const std::string& d) { remove_frames(d, "frame_", {".exr"}); });
+  WriteOptions exr;
+  exr.format = SampleFormat::kFloat;  // bit for bit: every task reads the same floats
+  exr.channel_names = render::channel_names();
+  write_image(paths_.passes_exr(frame), passes, exr);
 }
 
 FileStore::~FileStore() = default;
@@ -167,18 +264,11 @@ Image<float> FileStore::read_layer(const pipeline::Layer& layer, int frame) cons
 }
 
 void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) {
-  Manifested& m = layers_.at(layer.name);
-  if (!m.current) {
-    // Made with other settings: its old frames go before the new settings are recorded, so a
-    // run killed in between leaves no old frame under a new manifest.
-    const fs::path dir = fs::path(paths_.folder) / "layers" / layer.name;
-    std::error_code ec;
-    fs::remove(dir / kManifest, ec);
-    remove_frames(dir, layer.name + "_", {".png", ".exr"});
-    write_manifest((dir / kManifest).string(), m.want);
-    m.current = true;
-    m.stale.clear();
-  }
+  CHECK(access_ != StoreAccess::kInspect);
+  make_current(layers_.at(layer.name), (fs::path(paths_.folder) / "layers" / layer.name).string(),
+               [&](const std::string& dir) {
+                 remove_frames(dir, layer.name + "_", {".png", ".exr"});
+               });
   const int n = layer.single_colour ? 1 : 3;
   // The PNG first: the EXR is what marks the frame finished, so it is written last.
   if (shot_.outputs.layer_png) {
@@ -205,16 +295,13 @@ bool FileStore::has_frame(int frame) const {
 void FileStore::write_frame(int frame, ImageView<const float> composite,
                             const std::vector<ImageView<const float>>& layers,
                             ImageView<const float> passes) {
+  CHECK(access_ != StoreAccess::kInspect);
   const pipeline::Outputs& o = shot_.outputs;
-  if (!frames_.current) {
-    const fs::path root(paths_.folder);
-    std::error_code ec;
-    fs::remove(root / "composite" / kManifest, ec);
+  const fs::path root(paths_.folder);
+  make_current(frames_, (root / "composite").string(), [&](const std::string&) {
     remove_frames(root / "composite", "frame_", {".png", ".exr"});
     remove_frames(root / "layered", "frame_", {".exr"});
-    write_manifest((root / "composite" / kManifest).string(), frames_.want);
-    frames_.current = true;
-  }
+  });
   // The composite without its (constant) alpha.
   Image<float> rgb(composite.width, composite.height, 3);
   for (int y = 0; y < composite.height; ++y)
@@ -256,6 +343,43 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
     wo.format = SampleFormat::kU16;
     write_image(paths_.composite_png(frame), rgb.cview(), wo);
   }
+}
+
+namespace {
+
+// A scene's frames with the pass cache in front: a cached frame is read, any other rendered.
+class CachedFrames : public pipeline::FrameSource {
+ public:
+  CachedFrames(const Shot& shot, std::unique_ptr<pipeline::FrameSource> inner)
+      : paths_{shot.outputs.folder},
+        width_(shot.source.width),
+        height_(shot.source.height),
+        inner_(std::move(inner)) {}
+  Image<float> passes(int frame) const override {
+    const std::string file = paths_.passes_exr(frame);
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) return inner_->passes(frame);
+    Image<float> img = read_image_float(file, ReadOptions{render::channel_names()});
+    if (img.width() != width_ || img.height() != height_)
+      throw Error(file, fmt::format("is {}x{}, the shot makes {}x{}; {}", img.width(), img.height(),
+                                    width_, height_, kRedoHint));
+    return img;
+  }
+
+ private:
+  OutputPaths paths_;
+  int width_, height_;
+  std::unique_ptr<pipeline::FrameSource> inner_;
+};
+
+}  // namespace
+
+std::unique_ptr<pipeline::FrameSource> with_pass_cache(
+    const Shot& shot, std::unique_ptr<pipeline::FrameSource> frames) {
+  if (shot.source.kind != pipeline::SourceKind::kScene) return frames;
+  const auto have = read_manifest((fs::path(shot.outputs.folder) / "passes" / kManifest).string());
+  if (!have || *have != passes_manifest(shot)) return frames;
+  return std::make_unique<CachedFrames>(shot, std::move(frames));
 }
 
 }  // namespace emaki::io

@@ -3,12 +3,15 @@
 // settings that made it (io/shot_manifest.h).
 #pragma once
 
+#include <functional>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "io/output_store.h"
+#include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "pipeline/shot.h"
 
@@ -31,6 +34,16 @@ struct OutputPaths {
   std::string layered_exr(int frame) const;
   std::string mp4() const;
   std::string contact_sheet() const;
+  std::string passes_exr(int frame) const;  // the farm's pass cache
+};
+
+// Who else may write the folder meanwhile.
+enum class StoreAccess {
+  kAlone,     // nobody: an exclusive lock, and temporaries a killed run left are removed
+  kFarmTask,  // other tasks of the same shot (disjoint files): a shared lock, no clean-up, and
+              // every manifest must already be current (the shot's prepare task made it so)
+  kInspect,   // anyone: reads what is finished (a farm's plan and status) without a lock,
+              // creating nothing; writing is an invariant violation
 };
 
 enum class StoreMode {
@@ -45,8 +58,18 @@ class FileStore : public pipeline::Store {
  public:
   // Creates the folders, locks the output folder (emaki::Error naming the holder when another
   // emaki has it) and removes temporary files a killed run left behind.
-  explicit FileStore(const pipeline::Shot& shot, StoreMode mode = StoreMode::kRun);
+  explicit FileStore(const pipeline::Shot& shot, StoreMode mode = StoreMode::kRun,
+                     StoreAccess access = StoreAccess::kAlone);
   ~FileStore() override;
+  // Brings every manifest (layers, composites, the pass cache) up to date now, deleting frames
+  // made with other settings: what the farm's prepare task does before the other tasks run.
+  void prepare();
+  // The pass cache: a scene source's guide passes per frame, rendered once and read by every
+  // task of the shot (float EXR, so read back bit for bit).
+  bool has_passes(int frame) const;
+  // Every manifest is current: the farm's prepare task has nothing left to do.
+  bool prepared() const;
+  void write_passes(int frame, ImageView<const float> passes);
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
@@ -63,13 +86,26 @@ class FileStore : public pipeline::Store {
     std::string stale;     // !current and something is there: what changed
   };
   const Manifested& layer_state(const pipeline::Layer& layer) const;
+  // The manifest in `dir` against `want` (`prefix`/`exts`: the frame files it covers).
+  static Manifested manifested(const std::string& dir, Manifest want, const std::string& prefix,
+                               std::initializer_list<const char*> exts);
+  // Deletes the frames of `folder` made under other settings and records `m.want` there.
+  void make_current(Manifested& m, const std::string& folder,
+                    const std::function<void(const std::string&)>& remove_frames_in);
 
   const pipeline::Shot& shot_;
   StoreMode mode_;
+  StoreAccess access_;
   OutputPaths paths_;
   std::unique_ptr<FolderLock> lock_;
   std::map<std::string, Manifested> layers_;
   Manifested frames_;
+  Manifested passes_;
 };
+
+// `frames` with the shot's pass cache in front of it, when the cache holds passes made under the
+// shot's current source settings (otherwise `frames` as it is).
+std::unique_ptr<pipeline::FrameSource> with_pass_cache(
+    const pipeline::Shot& shot, std::unique_ptr<pipeline::FrameSource> frames);
 
 }  // namespace emaki::io

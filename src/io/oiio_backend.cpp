@@ -260,6 +260,9 @@ std::string write_impl(const std::string& path, ImageView<const float> image,
   if (names.empty() && (image.channels == 4 || image.channels == 2))
     spec.alpha_channel = image.channels - 1;
   spec.attribute("compression", "zip");
+  // OpenImageIO stamps EXRs with the time of writing (capDate) unless told a date: a fixed one
+  // makes the same image the same file, so runs (and farm tasks) can be compared byte for byte.
+  spec.attribute("DateTime", "2000:01:01 00:00:00");
   std::vector<float> buf(std::size_t(image.width) * image.height * image.channels);
   for (int y = 0; y < image.height; ++y) {
     const float* r = image.row(y);

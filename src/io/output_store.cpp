@@ -140,13 +140,14 @@ void remove_temporaries(const std::string& dir,
 
 // ---- the folder lock ----
 
-FolderLock::FolderLock(const std::string& folder) {
+FolderLock::FolderLock(const std::string& folder, Kind kind) {
   const std::string path = (fs::path(folder) / ".emaki.lock").string();
   fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd_ < 0)
     throw Error(
         path, fmt::format("cannot open the output folder's lock file ({})", std::strerror(errno)));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+  const int op = kind == Kind::kShared ? LOCK_SH : LOCK_EX;
+  if (::flock(fd_, op | LOCK_NB) != 0) {
     const int err = errno;
     std::string holder;
     if (err == EWOULDBLOCK) {
@@ -162,6 +163,15 @@ FolderLock::FolderLock(const std::string& folder) {
     throw Error(path, fmt::format("the output folder is in use by another emaki ({}); wait for "
                                   "it to finish or stop it",
                                   holder.empty() ? "holder unknown" : echo(holder)));
+  }
+  // Shared holders all write the same words, so their writes cannot interleave into nonsense.
+  if (kind == Kind::kShared) {
+    const std::string text = "farm tasks of this shot\n";
+    if (::ftruncate(fd_, 0) == 0) {
+      const ssize_t ignored = ::pwrite(fd_, text.data(), text.size(), 0);
+      (void)ignored;  // the content is informational only
+    }
+    return;
   }
   char host[256] = {};
   ::gethostname(host, sizeof host - 1);

@@ -55,8 +55,11 @@ unsigned long long random_u64();
 // process dies, so a killed run never blocks the next one).
 class FolderLock {
  public:
+  // kShared: the tasks of one shot on a render farm, which write disjoint files and may run at
+  // once; an exclusive holder (emaki run) and shared holders exclude each other.
+  enum class Kind { kExclusive, kShared };
   // Throws emaki::Error(lock file) naming the holder when another process holds it.
-  explicit FolderLock(const std::string& folder);
+  explicit FolderLock(const std::string& folder, Kind kind = Kind::kExclusive);
   ~FolderLock();
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;

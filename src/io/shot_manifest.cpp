@@ -112,6 +112,15 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
   return l.m;
 }
 
+Manifest passes_manifest(const pipeline::Shot& shot) {
+  Lines l;
+  l.add("outputs_format", kOutputsFormat);
+  add_source(l, shot);
+  // An automatic camera frames the whole range.
+  l.add("source.last_frame", shot.source.last_frame);
+  return l.m;
+}
+
 Manifest frames_manifest(const pipeline::Shot& shot) {
   Lines l;
   l.add("outputs_format", kOutputsFormat);

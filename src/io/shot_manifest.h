@@ -15,5 +15,7 @@ inline constexpr int kOutputsFormat = 1;
 
 Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer);
 Manifest frames_manifest(const pipeline::Shot& shot);
+// The guide passes of a scene source's frames (the farm's pass cache, passes/frame_%04d.exr).
+Manifest passes_manifest(const pipeline::Shot& shot);
 
 }  // namespace emaki::io

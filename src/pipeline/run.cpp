@@ -246,7 +246,7 @@ RunReport run_shot(const Shot& shot, const FrameSource& frames,
       ++report.synthesized;
       changed = true;
     }
-    if (f >= a && (changed || o.force || !store.has_frame(f))) {
+    if (o.composite && f >= a && (changed || o.force || !store.has_frame(f))) {
       bool complete = true;
       std::vector<Image<float>> read_back;
       read_back.reserve(shot.layers.size());  // views point into it: no reallocation

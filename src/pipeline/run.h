@@ -51,6 +51,7 @@ struct RunOptions {
   int first_frame = -1, last_frame = -1;  // -1: the shot's range
   std::vector<std::string> layers;        // empty: all
   bool force = false;                     // synthesize again even when finished
+  bool composite = true;                  // false: layers only (a farm's layer task)
   std::function<void(const Progress&)> progress;
 };
 

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "io/file_store.h"
 #include "io/frame_sequence.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
@@ -76,7 +77,7 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
   const pipeline::Source& s = shot.source;
   try {
     if (s.kind == pipeline::SourceKind::kSequence) return io::open_sequence(s);
-    return pipeline::scene_frames(io::load_gltf(s.scene_path), s);
+    return io::with_pass_cache(shot, pipeline::scene_frames(io::load_gltf(s.scene_path), s));
   } catch (const Error& e) {
     rethrow_as_key(e, "source");
   }

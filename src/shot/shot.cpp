@@ -20,12 +20,17 @@ pipeline::RunOptions run_options(const Request& r) {
   o.last_frame = r.last_frame;
   o.layers = r.layers;
   o.force = r.force;
+  o.composite = r.composite;
   o.progress = r.progress;
   return o;
 }
 
 void use_threads(const pipeline::Shot& shot, const Request& r) {
   set_thread_count(r.threads >= 0 ? r.threads : shot.threads);
+}
+
+io::StoreAccess access(const Request& r) {
+  return r.farm_task ? io::StoreAccess::kFarmTask : io::StoreAccess::kAlone;
 }
 
 std::vector<std::string> previews(const pipeline::Shot& shot, const Request& r) {
@@ -51,7 +56,7 @@ RunResult run(const pipeline::Shot& shot, const Request& request) {
   const auto exemplars = load_exemplars(shot);
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);
   RunResult out;
-  io::FileStore store(shot);  // holds the folder's lock until the previews are written
+  io::FileStore store(shot, io::StoreMode::kRun, access(request));  // locked until the end
   out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request));
   out.previews = previews(shot, request);
   return out;
@@ -64,10 +69,41 @@ CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);
   CompositeResult out;
   // Layers made with other settings are an error here: re-colouring never synthesizes.
-  io::FileStore store(shot, io::StoreMode::kReadFinished);
+  io::FileStore store(shot, io::StoreMode::kReadFinished, access(request));
   out.composited = pipeline::recomposite(shot, *frames, ci, store, run_options(request));
   out.previews = previews(shot, request);
   return out;
+}
+
+void prepare(const pipeline::Shot& shot) {
+  // Everything that can fail on the inputs fails here, before a single task writes a file.
+  (void)open_frames(shot);
+  (void)load_exemplars(shot);
+  (void)load_composite_inputs(shot);
+  io::FileStore store(shot);
+  store.prepare();
+}
+
+int render_passes(const pipeline::Shot& shot, const Request& request) {
+  pipeline::check_run_options(shot, run_options(request));
+  if (shot.source.kind != pipeline::SourceKind::kScene) return 0;
+  use_threads(shot, request);
+  const auto frames = open_frames(shot);
+  io::FileStore store(shot, io::StoreMode::kRun, access(request));
+  const int a = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
+  const int b = request.last_frame < 0 ? shot.source.last_frame : request.last_frame;
+  int rendered = 0;
+  for (int f = a; f <= b; ++f) {
+    if (store.has_passes(f)) continue;
+    store.write_passes(f, frames->passes(f).cview());
+    ++rendered;
+  }
+  return rendered;
+}
+
+std::vector<std::string> write_previews(const pipeline::Shot& shot, const Request& request) {
+  io::FileStore store(shot, io::StoreMode::kReadFinished, access(request));
+  return io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
 }
 
 FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,

@@ -28,6 +28,10 @@ struct Request {
   bool force = false;                     // run: synthesize finished frames again
   bool previews = true;                   // contact sheet and MP4, as the shot's outputs ask
   int threads = -1;                       // -1: the shot's `threads`; 0: all cores
+  bool composite = true;                  // run: composite the frames whose layers are done
+  // A render-farm task beside other tasks of the same shot (shot/plan.h): shares the output
+  // folder's lock, leaves clean-up to the prepare task and needs the folder prepared.
+  bool farm_task = false;
   std::function<void(const pipeline::Progress&)> progress;
 };
 
@@ -48,6 +52,20 @@ struct CompositeResult {
 // Re-composites finished layers with the shot's current colours, blends and paper; layers made
 // with other settings are an error naming the layer folder.
 CompositeResult composite(const pipeline::Shot& shot, const Request& request);
+
+// A farm's first task of a shot: checks every input, locks the folder alone, removes what a
+// killed run left and brings every manifest up to date (deleting outputs made under other
+// settings), so that the shot's other tasks can then run side by side.
+void prepare(const pipeline::Shot& shot);
+
+// Renders the requested frames' guide passes into the shot's pass cache (passes/), skipping
+// frames already there; every later task reads them instead of rendering. A sequence source
+// has its passes in files already: nothing to do. Returns the frames rendered.
+int render_passes(const pipeline::Shot& shot, const Request& request);
+
+// The contact sheet and MP4 the shot asks for, once every frame is composited. Returns the files
+// written (none while frames are missing).
+std::vector<std::string> write_previews(const pipeline::Shot& shot, const Request& request);
 
 struct FlickerResult {
   int first_frame = 0, last_frame = 0;

@@ -1,0 +1,199 @@
+// A production on a render farm: `emaki plan` (the task graph, as a table or JSON), `emaki farm
+// submit | status | cancel` (Slurm), and `emaki task KIND SHOT` (one task of the plan: what a
+// farm node runs).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <climits>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "apps/emaki/commands.h"
+#include "apps/emaki/shot_command.h"
+#include "core/error.h"
+#include "core/limits.h"
+#include "farm/slurm.h"
+#include "shot/plan.h"
+#include "shot/shot.h"
+
+namespace emaki::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The running binary, so that farm nodes run the same emaki (shared storage).
+std::string this_binary() {
+  char buf[PATH_MAX] = {};
+  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+  return n > 0 ? std::string(buf, std::size_t(n)) : std::string("emaki");
+}
+
+// Shot files and how their plan is cut, shared by plan and every farm subcommand.
+struct PlanArgs {
+  std::vector<std::string> shots;
+  int chunk = 8, threads = 1;
+
+  void bind(CLI::App& app) {
+    app.add_option("shots", shots, "shot files (TOML)")->required();
+    app.add_option("--chunk", chunk, "frames per passes / layer / composite task (default 8)");
+    app.add_option("--threads", threads, "threads (CPUs) per task (default 1)");
+  }
+  shot::Plan make() const {
+    shot::PlanOptions o;
+    o.emaki = this_binary();
+    o.chunk = chunk;
+    o.threads = threads;
+    std::vector<std::string> paths;
+    for (const std::string& s : shots) paths.push_back(fs::absolute(s).lexically_normal().string());
+    return shot::plan(paths, o);
+  }
+};
+
+void print_plan(const shot::Plan& plan) {
+  std::printf("%-40s %-9s %7s %6s  %s\n", "task", "kind", "mem MB", "state", "after");
+  for (const shot::Task& t : plan.tasks) {
+    std::string after;
+    for (const std::string& a : t.after) after += (after.empty() ? "" : " ") + a;
+    std::printf("%-40s %-9s %7ld %6s  %s\n", t.id.c_str(), shot::task_kind_name(t.kind),
+                long(t.memory_mb), t.done ? "done" : "to do", after.c_str());
+  }
+}
+
+int farm_submit(const Args& args) {
+  CLI::App app{"Submits the shots' unfinished tasks to Slurm as job arrays (sbatch).",
+               "emaki farm submit"};
+  PlanArgs p;
+  farm::SlurmOptions o;
+  p.bind(app);
+  app.add_option("--partition", o.partition, "Slurm partition");
+  app.add_option("--account", o.account, "Slurm account");
+  app.add_option("--time", o.time, "Slurm time limit per task (e.g. 2:00:00)");
+  app.add_flag("--dry-run", o.dry_run, "print the batch scripts; submit and write nothing");
+  if (parse_cli(app, args)) return 0;
+  const shot::Plan plan = p.make();
+  const farm::Submitted s = farm::submit(plan, o);
+  if (o.dry_run) {
+    for (const std::string& script : s.scripts) std::printf("%s\n", script.c_str());
+    return 0;
+  }
+  for (const std::string& script : s.scripts)
+    std::fprintf(stderr, "emaki farm: submitted %s\n", script.c_str());
+  std::fprintf(stderr, "emaki farm: %d tasks in %d job arrays submitted, %d finished already\n",
+               s.tasks, s.jobs, s.done);
+  return 0;
+}
+
+int farm_status(const Args& args) {
+  CLI::App app{
+      "Each task of the shots: pending, running, done, failed (with its log and error "
+      "line) or not run.",
+      "emaki farm status"};
+  PlanArgs p;
+  p.bind(app);
+  if (parse_cli(app, args)) return 0;
+  const shot::Plan plan = p.make();
+  std::map<std::string, int> count;
+  for (const farm::TaskStatus& st : farm::status(plan)) {
+    const char* state = farm::task_state_name(st.state);
+    ++count[state];
+    std::printf("%-40s %-13s %-10s %s\n", st.task->id.c_str(), state, st.job.c_str(),
+                st.detail.c_str());
+  }
+  std::string summary;
+  for (const auto& [state, n] : count)
+    summary += fmt::format("{}{} {}", summary.empty() ? "" : ", ", n, state);
+  std::printf("%s\n", summary.c_str());
+  return 0;
+}
+
+int farm_cancel(const Args& args) {
+  CLI::App app{"Cancels the shots' queued and running jobs (scancel).", "emaki farm cancel"};
+  PlanArgs p;
+  p.bind(app);
+  if (parse_cli(app, args)) return 0;
+  const int n = farm::cancel(p.make());
+  std::fprintf(stderr, "emaki farm: cancelled %d job arrays\n", n);
+  return 0;
+}
+
+}  // namespace
+
+int run_plan(const Args& args) {
+  CLI::App app{
+      "The shots as a task graph for a farm scheduler: a table, or JSON (--json; "
+      "docs/farm.md documents it).",
+      "emaki plan"};
+  PlanArgs p;
+  bool json = false;
+  p.bind(app);
+  app.add_flag("--json", json, "print the plan as JSON");
+  if (parse_cli(app, args)) return 0;
+  const shot::Plan plan = p.make();
+  if (json)
+    std::printf("%s", shot::plan_json(plan).c_str());
+  else
+    print_plan(plan);
+  return 0;
+}
+
+int run_farm(const Args& args) {
+  const std::string usage = "usage: emaki farm submit|status|cancel SHOT... (see --help of each)";
+  if (args.empty()) throw Error("", usage);
+  const Args rest(args.begin() + 1, args.end());
+  if (args[0] == "submit") return farm_submit(rest);
+  if (args[0] == "status") return farm_status(rest);
+  if (args[0] == "cancel") return farm_cancel(rest);
+  throw Error("", usage);
+}
+
+int run_task(const Args& args) {
+  const std::string usage =
+      "usage: emaki task prepare|passes|layer|composite|previews SHOT [--frames A-B] "
+      "[--layer NAME] (one task of `emaki plan`)";
+  if (args.empty()) throw Error("", usage);
+  const std::string kind = args[0];
+  CLI::App app{
+      "One task of a shot's plan, as a farm node runs it beside the shot's other "
+      "tasks.",
+      "emaki task " + kind};
+  ShotCommand c;
+  std::string layer;
+  c.bind(app, "FIRST-LAST or FRAME");
+  if (kind == "layer") app.add_option("--layer", layer, "the layer")->required();
+  if (parse_cli(app, Args(args.begin() + 1, args.end()))) return 0;
+  const pipeline::Shot shot = shot::open(c.shot_path);
+  shot::Request r = c.request("task");
+  r.farm_task = true;
+  r.previews = false;
+  if (kind == "prepare") {
+    shot::prepare(shot);
+  } else if (kind == "passes") {
+    const int n = shot::render_passes(shot, r);
+    std::fprintf(stderr, "emaki task: %d frames of passes rendered\n", n);
+  } else if (kind == "layer") {
+    if (!shot.find_layer(layer))
+      throw Error(Error::Field{"layer"}, fmt::format("no layer '{}' in the shot", echo(layer)));
+    r.layers = {layer};
+    r.composite = false;
+    const shot::RunResult res = shot::run(shot, r);
+    end_progress_line();
+    std::fprintf(stderr, "emaki task: layer %s: %d frames synthesized, %d finished already\n",
+                 layer.c_str(), res.report.synthesized, res.report.reused);
+  } else if (kind == "composite") {
+    r.progress = nullptr;
+    std::fprintf(stderr, "emaki task: %d frames composited\n", shot::composite(shot, r).composited);
+  } else if (kind == "previews") {
+    for (const std::string& f : shot::write_previews(shot, r))
+      std::fprintf(stderr, "emaki task: wrote %s\n", f.c_str());
+  } else {
+    throw Error("", usage);
+  }
+  return 0;
+}
+
+}  // namespace emaki::app

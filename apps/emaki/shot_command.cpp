@@ -1,0 +1,84 @@
+#include "apps/emaki/shot_command.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "apps/emaki/frame_range.h"
+
+namespace emaki::app {
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    if (end > start) out.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+namespace {
+
+std::string duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  const int t = int(std::lround(s));
+  return t >= 3600 ? fmt::format("{}h{:02d}m", t / 3600, t / 60 % 60)
+                   : fmt::format("{}m{:02d}s", t / 60, t % 60);
+}
+
+}  // namespace
+
+std::function<void(const pipeline::Progress&)> progress_printer(const char* command) {
+  const bool tty = ::isatty(2);
+  return [tty, command](const pipeline::Progress& p) {
+    std::string line;
+    if (p.layer.empty()) {
+      line = fmt::format("emaki {}: frame {} compositing", command, p.frame);
+    } else {
+      const double eta = p.done > 0 ? p.elapsed_s / p.done * (p.total - p.done) : NAN;
+      line =
+          fmt::format("emaki {}: frame {} layer {} ({}/{}, {} elapsed, ETA {})", command, p.frame,
+                      p.layer, p.done + 1, p.total, duration(p.elapsed_s), duration(eta));
+    }
+    if (tty)
+      std::fprintf(stderr, "\r\033[K%s", line.c_str());
+    else
+      std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
+  };
+}
+
+void end_progress_line() {
+  if (::isatty(2)) std::fprintf(stderr, "\n");
+}
+
+void ShotCommand::bind(CLI::App& app, const char* frames_help) {
+  app.add_option("shot", shot_path, "the shot file (TOML; see docs/shot_file.md)")->required();
+  app.add_option("--frames", frames, frames_help);
+  app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores (default: the shot's)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+void ShotCommand::bind_previews(CLI::App& app) {
+  app.add_flag("--no-previews", no_previews, "do not write the contact sheet and the MP4");
+}
+
+shot::Request ShotCommand::request(const char* command) const {
+  shot::Request r;
+  if (!frames.empty()) {
+    const FrameRange range = parse_frame_range("--frames", frames);
+    r.first_frame = range.first;
+    r.last_frame = range.last;
+  }
+  r.layers = split_commas(layers);
+  r.previews = !no_previews;
+  r.threads = threads;
+  r.progress = progress_printer(command);
+  return r;
+}
+
+}  // namespace emaki::app

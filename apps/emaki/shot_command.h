@@ -1,0 +1,35 @@
+// What the shot commands (run, composite, qa, task) share: the shot file, --frames, --threads
+// and --no-previews bound to one shot::Request, and progress on stderr.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "apps/emaki/shot_options.h"
+#include "pipeline/run.h"
+#include "shot/shot.h"
+
+namespace emaki::app {
+
+// "a,b,,c" -> {"a", "b", "c"}.
+std::vector<std::string> split_commas(const std::string& text);
+
+// Progress on stderr: one updating line on a terminal, one line per step otherwise.
+std::function<void(const pipeline::Progress&)> progress_printer(const char* command);
+// Ends the updating line (on a terminal).
+void end_progress_line();
+
+struct ShotCommand {
+  std::string shot_path, frames, layers;
+  bool no_previews = false;
+  int threads = -1;
+
+  // The shot file, --frames (its help text given) and --threads.
+  void bind(CLI::App& app, const char* frames_help);
+  void bind_previews(CLI::App& app);
+  // The request; --frames is optional: empty leaves the shot's whole range.
+  shot::Request request(const char* command) const;
+};
+
+}  // namespace emaki::app

@@ -1,0 +1,51 @@
+// The plan (shot/plan.h) on Slurm: one job array per (shot, task kind) with the tasks still to
+// do, each array `--dependency=afterok` on the arrays holding the tasks it waits for, job ids
+// recorded in the shot's output folder (farm/jobs.tsv), logs per task (farm/logs/TASK.log) and
+// each task's exit code (farm/status/TASK.exit). Shared storage is assumed: every node sees the
+// shot files, their inputs and the output folders under the same paths.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "shot/plan.h"
+
+namespace emaki::farm {
+
+struct SlurmOptions {
+  std::string partition, account, time;  // sbatch's --partition, --account, --time when set
+  bool dry_run = false;                  // print the scripts; submit nothing, write nothing
+};
+
+struct Submitted {
+  std::vector<std::string> scripts;  // dry run: the scripts' text; else their paths
+  int jobs = 0;                      // job arrays submitted
+  int tasks = 0;                     // tasks in them
+  int done = 0;                      // tasks left out as finished already
+};
+
+// Submits the plan's unfinished tasks. Throws emaki::Error naming a shot file when that shot
+// still has jobs in the queue, or the failing command when sbatch refuses a script.
+Submitted submit(const shot::Plan& plan, const SlurmOptions& options);
+
+// A batch script for `tasks` (one array; all of one shot); `depends` are job ids.
+std::string batch_script(const shot::Plan& plan, const std::vector<const shot::Task*>& tasks,
+                         const std::vector<std::string>& depends, const SlurmOptions& options);
+
+enum class TaskState { kDone, kRunning, kPending, kFailed, kNotRun, kNotSubmitted };
+const char* task_state_name(TaskState s);
+
+struct TaskStatus {
+  const shot::Task* task = nullptr;
+  TaskState state = TaskState::kNotSubmitted;
+  std::string job;     // "JOBID_INDEX"
+  std::string detail;  // a failed task's exit code, log and error line; a pending task's reason
+};
+
+// Every task's state, from the queue (squeue), the exit codes and the outputs on disk.
+std::vector<TaskStatus> status(const shot::Plan& plan);
+
+// Cancels every queued job of the plan's shots (scancel). Returns the job arrays cancelled.
+int cancel(const shot::Plan& plan);
+
+}  // namespace emaki::farm

@@ -1,0 +1,260 @@
+#include "shot/plan.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include "core/error.h"
+#include "core/limits.h"
+#include "io/file_store.h"
+#include "render/passes.h"
+#include "shot/shot.h"
+
+namespace emaki::shot {
+
+namespace fs = std::filesystem;
+
+const char* task_kind_name(TaskKind kind) {
+  switch (kind) {
+    case TaskKind::kPrepare:
+      return "prepare";
+    case TaskKind::kPasses:
+      return "passes";
+    case TaskKind::kLayer:
+      return "layer";
+    case TaskKind::kComposite:
+      return "composite";
+    case TaskKind::kPreviews:
+      return "previews";
+  }
+  return "?";
+}
+
+namespace {
+
+// Peak resident memory of a task, from the image sizes (bench/farm_bench.sh measured the
+// constants: see docs/farm.md). Rounded up to 64 MB, plus the process's fixed cost.
+int64_t memory_estimate(const PlannedShot& ps, TaskKind kind) {
+  const pipeline::Shot& s = ps.shot;
+  const double pixels = double(s.source.width) * s.source.height;
+  const double aa = s.source.kind == pipeline::SourceKind::kScene ? s.source.render.aa : 1;
+  const double pass_bytes = double(render::kChannelCount) * 4;
+  double bytes = 0;
+  switch (kind) {
+    case TaskKind::kPrepare:
+    case TaskKind::kPasses:
+      bytes = pixels * aa * aa * pass_bytes * 2;  // the supersampled frame and its resolve
+      break;
+    case TaskKind::kLayer:
+      bytes = pixels * (pass_bytes * 3 + 600);  // two frames' passes, advection, the pyramid
+      break;
+    case TaskKind::kComposite:
+      bytes = pixels * (pass_bytes * 2 + 200);
+      break;
+    case TaskKind::kPreviews:
+      bytes = 12 * pixels * 12 + 320 * 240 * 12 * 4;  // 12 thumbnails' frames
+      break;
+  }
+  const int64_t mb = 160 + int64_t(bytes / (1 << 20));
+  return (mb + 63) / 64 * 64;
+}
+
+std::string frames_text(int a, int b) {
+  return fmt::format("{}-{}", a, b);
+}
+
+class Planner {
+ public:
+  Planner(Plan& plan, const PlanOptions& o) : plan_(plan), o_(o) {}
+
+  void add_shot(int index) {
+    const PlannedShot& ps = plan_.shots[std::size_t(index)];
+    const pipeline::Shot& s = ps.shot;
+    const io::FileStore state(s, io::StoreMode::kRun, io::StoreAccess::kInspect);
+    const std::string& out = s.outputs.folder;
+    const int first = s.source.first_frame, last = s.source.last_frame;
+
+    const bool scene = s.source.kind == pipeline::SourceKind::kScene;
+    bool prepared = state.prepared();
+    const std::string prepare =
+        add(index, TaskKind::kPrepare, "", first, last, {out}, {}, prepared);
+    std::vector<std::string> passes;
+    if (scene)
+      for (int a = first; a <= last; a += o_.chunk) {
+        const int b = std::min(last, a + o_.chunk - 1);
+        bool done = prepared;
+        for (int f = a; f <= b && done; ++f) done = state.has_passes(f);
+        passes.push_back(
+            add(index, TaskKind::kPasses, "", a, b, {out + "/passes"}, {prepare}, done));
+      }
+    const std::vector<std::string> before_layers = scene ? passes : std::vector{prepare};
+    std::vector<std::string> layers;
+    for (const pipeline::Layer& l : s.layers) {
+      const int step = l.temporal.enabled ? last - first + 1 : o_.chunk;
+      for (int a = first; a <= last; a += step) {
+        const int b = std::min(last, a + step - 1);
+        bool done = prepared;
+        for (int f = a; f <= b && done; ++f) done = state.has_layer(l, f);
+        layers.push_back(add(index, TaskKind::kLayer, l.name, a, b, {out + "/layers/" + l.name},
+                             before_layers, done));
+      }
+    }
+    std::vector<std::string> composites;
+    for (int a = first; a <= last; a += o_.chunk) {
+      const int b = std::min(last, a + o_.chunk - 1);
+      bool done = prepared;
+      for (int f = a; f <= b && done; ++f) done = state.has_frame(f);
+      composites.push_back(add(index, TaskKind::kComposite, "", a, b,
+                               {out + "/composite", out + "/layered"}, layers, done));
+    }
+    // Previews are cheap and are remade whenever anything else is.
+    bool all_done = true;
+    for (const Task& t : plan_.tasks) all_done = all_done && (t.shot != index || t.done);
+    add(index, TaskKind::kPreviews, "", first, last, {out}, composites,
+        all_done && previews_exist(s));
+  }
+
+ private:
+  static bool previews_exist(const pipeline::Shot& s) {
+    const io::OutputPaths paths{s.outputs.folder};
+    std::error_code ec;
+    if (s.outputs.contact_sheet && !fs::is_regular_file(paths.contact_sheet(), ec)) return false;
+    if (s.outputs.mp4 && !fs::is_regular_file(paths.mp4(), ec)) return false;
+    return true;
+  }
+
+  std::string add(int shot, TaskKind kind, const std::string& layer, int a, int b,
+                  std::vector<std::string> outputs, const std::vector<std::string>& after,
+                  bool done) {
+    const PlannedShot& ps = plan_.shots[std::size_t(shot)];
+    Task t;
+    t.shot = shot;
+    t.kind = kind;
+    t.layer = layer;
+    t.first_frame = a;
+    t.last_frame = b;
+    t.id = ps.name + "." + task_kind_name(kind);
+    if (!layer.empty()) t.id += "." + layer;
+    if (kind == TaskKind::kPasses || kind == TaskKind::kLayer || kind == TaskKind::kComposite)
+      t.id += "." + frames_text(a, b);
+    t.argv = {o_.emaki, "task", task_kind_name(kind), ps.path};
+    if (!layer.empty()) t.argv.insert(t.argv.end(), {"--layer", layer});
+    if (kind != TaskKind::kPrepare && kind != TaskKind::kPreviews)
+      t.argv.insert(t.argv.end(), {"--frames", frames_text(a, b)});
+    t.threads = o_.threads;
+    t.argv.insert(t.argv.end(), {"--threads", std::to_string(o_.threads)});
+    t.outputs = std::move(outputs);
+    t.memory_mb = memory_estimate(ps, kind);
+    t.done = done;
+    for (const std::string& id : after)
+      if (!find(id)->done) t.after.push_back(id);
+    plan_.tasks.push_back(std::move(t));
+    return plan_.tasks.back().id;
+  }
+
+  const Task* find(const std::string& id) const {
+    for (const Task& t : plan_.tasks)
+      if (t.id == id) return &t;
+    return nullptr;
+  }
+
+  Plan& plan_;
+  const PlanOptions& o_;
+};
+
+}  // namespace
+
+Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
+  if (options.chunk < 1 || options.chunk > kMaxFrameCount)
+    throw Error(Error::Field{"chunk"},
+                fmt::format("must be in [1, {}], got {}", kMaxFrameCount, options.chunk));
+  if (options.threads < 1 || options.threads > 1024)
+    throw Error(Error::Field{"threads"},
+                fmt::format("must be in [1, 1024], got {}", options.threads));
+  Plan p;
+  std::map<std::string, int> names;
+  std::map<std::string, std::string> folders;
+  for (PlannedShot& s : shots) {
+    const std::string folder = fs::weakly_canonical(s.shot.outputs.folder).string();
+    if (const auto it = folders.find(folder); it != folders.end())
+      throw Error(Error::Field{"shots"},
+                  fmt::format("'{}' and '{}' write the same output folder '{}'", echo(it->second),
+                              echo(s.path), echo(folder)));
+    folders[folder] = s.path;
+    if (s.name.empty()) s.name = fs::path(s.path).stem().string();
+    if (const int n = names[s.name]++; n > 0) s.name += fmt::format("-{}", n + 1);
+    p.shots.push_back(std::move(s));
+  }
+  Planner planner(p, options);
+  for (int i = 0; i < int(p.shots.size()); ++i) planner.add_shot(i);
+  return p;
+}
+
+Plan plan(const std::vector<std::string>& shot_paths, const PlanOptions& options) {
+  std::vector<PlannedShot> shots;
+  for (const std::string& path : shot_paths) shots.push_back({"", path, open(path)});
+  return plan(std::move(shots), options);
+}
+
+namespace {
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20)
+          out += fmt::format("\\u{:04x}", int(static_cast<unsigned char>(c)));
+        else
+          out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_strings(const std::vector<std::string>& v) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + json_string(v[i]);
+  return out + "]";
+}
+
+}  // namespace
+
+std::string plan_json(const Plan& plan) {
+  std::string out = "{\n  \"format\": \"emaki-plan-1\",\n  \"shots\": [\n";
+  for (std::size_t i = 0; i < plan.shots.size(); ++i) {
+    const PlannedShot& s = plan.shots[i];
+    out += fmt::format(
+        "    {{\"name\": {}, \"path\": {}, \"output_folder\": {}, \"frames\": [{}, {}], "
+        "\"size\": [{}, {}]}}{}\n",
+        json_string(s.name), json_string(s.path), json_string(s.shot.outputs.folder),
+        s.shot.source.first_frame, s.shot.source.last_frame, s.shot.source.width,
+        s.shot.source.height, i + 1 < plan.shots.size() ? "," : "");
+  }
+  out += "  ],\n  \"tasks\": [\n";
+  for (std::size_t i = 0; i < plan.tasks.size(); ++i) {
+    const Task& t = plan.tasks[i];
+    out += fmt::format(
+        "    {{\"id\": {}, \"shot\": {}, \"kind\": \"{}\", \"layer\": {}, \"frames\": [{}, {}], "
+        "\"argv\": {}, \"outputs\": {}, \"memory_mb\": {}, \"threads\": {}, \"after\": {}, "
+        "\"done\": {}}}{}\n",
+        json_string(t.id), json_string(plan.shots[std::size_t(t.shot)].name),
+        task_kind_name(t.kind), t.layer.empty() ? "null" : json_string(t.layer), t.first_frame,
+        t.last_frame, json_strings(t.argv), json_strings(t.outputs), t.memory_mb, t.threads,
+        json_strings(t.after), t.done ? "true" : "false", i + 1 < plan.tasks.size() ? "," : "");
+  }
+  return out + "  ]\n}\n";
+}
+
+}  // namespace emaki::shot
