@@ -85,7 +85,7 @@ class Planner {
       for (int a = first; a <= last; a += o_.chunk) {
         const int b = std::min(last, a + o_.chunk - 1);
         bool done = prepared;
-        for (int f = a; f <= b && done; ++f) done = state.has_passes(f);
+        for (int f = a; f <= b && done; ++f) done = state.has_passes(f) || finished(s, state, f);
         passes.push_back(
             add(index, TaskKind::kPasses, "", a, b, {out + "/passes"}, {prepare}, done));
       }
@@ -117,6 +117,13 @@ class Planner {
   }
 
  private:
+  // Every output of frame `f` is there: its passes are needed by no task.
+  static bool finished(const pipeline::Shot& s, const io::FileStore& state, int f) {
+    for (const pipeline::Layer& l : s.layers)
+      if (!state.has_layer(l, f)) return false;
+    return state.has_frame(f);
+  }
+
   static bool previews_exist(const pipeline::Shot& s) {
     const io::OutputPaths paths{s.outputs.folder};
     std::error_code ec;
