@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/file_store.h"
-#include "render/passes.h"
+#include "io/image_io.h"
 #include "shot/shot.h"
 
 namespace emaki::shot {
@@ -34,31 +34,42 @@ const char* task_kind_name(TaskKind kind) {
 
 namespace {
 
-// Peak resident memory of a task, from the image sizes (bench/farm_bench.sh measured the
-// constants: see docs/farm.md). Rounded up to 64 MB, plus the process's fixed cost.
-int64_t memory_estimate(const PlannedShot& ps, TaskKind kind) {
-  const pipeline::Shot& s = ps.shot;
-  const double pixels = double(s.source.width) * s.source.height;
+// Peak resident memory of a task in MB, from the frame size and the exemplars' sizes. The
+// constants are peak RSS per pixel measured with /usr/bin/time on `emaki task` at 160x90,
+// 480x270 and 960x540 with the StyLit exemplar (docs/farm.md), plus a quarter for margin.
+int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind) {
+  const double px = double(s.source.width) * s.source.height;
   const double aa = s.source.kind == pipeline::SourceKind::kScene ? s.source.render.aa : 1;
-  const double pass_bytes = double(render::kChannelCount) * 4;
-  double bytes = 0;
+  double mb = 0;
   switch (kind) {
     case TaskKind::kPrepare:
+      mb = 60 + (exemplar_pixels * 360 + px * 100) / 1e6;
+      break;
     case TaskKind::kPasses:
-      bytes = pixels * aa * aa * pass_bytes * 2;  // the supersampled frame and its resolve
+      mb = 170 + px * aa * aa * 50 / 1e6;
       break;
     case TaskKind::kLayer:
-      bytes = pixels * (pass_bytes * 3 + 600);  // two frames' passes, advection, the pyramid
+      mb = 60 + (exemplar_pixels * 330 + px * 300) / 1e6;
       break;
     case TaskKind::kComposite:
-      bytes = pixels * (pass_bytes * 2 + 200);
+      mb = 150 + px * 550 / 1e6;
       break;
     case TaskKind::kPreviews:
-      bytes = 12 * pixels * 12 + 320 * 240 * 12 * 4;  // 12 thumbnails' frames
+      mb = 60 + px * 60 / 1e6;
       break;
   }
-  const int64_t mb = 160 + int64_t(bytes / (1 << 20));
-  return (mb + 63) / 64 * 64;
+  const int64_t with_margin = int64_t(mb * 1.25) + 1;
+  return (with_margin + 63) / 64 * 64;
+}
+
+// The exemplars' painting pixels (they dominate a small shot's memory).
+double exemplar_pixels(const pipeline::Shot& s) {
+  double px = 0;
+  for (const pipeline::Exemplar& e : s.exemplars) {
+    const io::AnyImage img = io::read_image(e.painting);
+    px += double(img.width()) * img.height();
+  }
+  return px;
 }
 
 std::string frames_text(int a, int b) {
@@ -75,6 +86,7 @@ class Planner {
     const io::FileStore state(s, io::StoreMode::kRun, io::StoreAccess::kInspect);
     const std::string& out = s.outputs.folder;
     const int first = s.source.first_frame, last = s.source.last_frame;
+    exemplar_pixels_ = exemplar_pixels(s);
 
     const bool scene = s.source.kind == pipeline::SourceKind::kScene;
     bool prepared = state.prepared();
@@ -153,7 +165,7 @@ class Planner {
     t.threads = o_.threads;
     t.argv.insert(t.argv.end(), {"--threads", std::to_string(o_.threads)});
     t.outputs = std::move(outputs);
-    t.memory_mb = memory_estimate(ps, kind);
+    t.memory_mb = memory_estimate(ps.shot, exemplar_pixels_, kind);
     t.done = done;
     for (const std::string& id : after)
       if (!find(id)->done) t.after.push_back(id);
@@ -169,6 +181,7 @@ class Planner {
 
   Plan& plan_;
   const PlanOptions& o_;
+  double exemplar_pixels_ = 0;
 };
 
 }  // namespace
