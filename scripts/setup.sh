@@ -1,10 +1,11 @@
 #!/bin/sh
-# Installs the Debian 12 packages emaki builds with (skips those already installed).
+# Installs the Debian 12 packages emaki builds and tests with (skips those already installed);
+# slurm-wlm and munge run the private test cluster of scripts/slurm/start.sh (daemons not started).
 set -e
 PKGS="build-essential cmake pkg-config libopenimageio-dev openimageio-tools libopencv-core-dev
 libopenexr-dev libtinygltf-dev libtbb-dev libcli11-dev libtomlplusplus-dev libfmt-dev
 libglm-dev libgtest-dev libgmock-dev libbenchmark-dev libpng-dev ffmpeg blender python3-numpy
-clang-14 libclang-rt-14-dev clang-format"
+clang-14 libclang-rt-14-dev clang-format slurm-wlm slurm-client munge"
 missing=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

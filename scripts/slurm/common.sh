@@ -1,0 +1,82 @@
+# Shared by scripts/slurm/start.sh and stop.sh (sourced, not run). Sets $dir to the absolute
+# state directory: the first argument, else $EMAKI_SLURM_DIR, else <repo>/build/slurm.
+slurm_here=$(cd "$(dirname "$0")" && pwd)
+dir=${1:-${EMAKI_SLURM_DIR:-$slurm_here/../../build/slurm}}
+mkdir -p "$dir" || exit 1
+dir=$(cd "$dir" && pwd)
+conf=$dir/slurm.conf
+export SLURM_CONF=$conf
+
+log() { echo "slurm: $*" >&2; }
+
+# Prints the pid in pid file $2 when that process is alive, is the daemon $1 and was started for
+# this state dir (its command line names $dir): a stale or reused pid prints nothing.
+daemon_pid() {
+  local pid
+  [ -s "$2" ] || return 1
+  pid=$(tr -dc '0-9' <"$2")
+  [ -n "$pid" ] && [ -d "/proc/$pid" ] || return 1
+  [ "$(cat "/proc/$pid/comm" 2>/dev/null)" = "$1" ] || return 1
+  { tr '\0' ' ' <"/proc/$pid/cmdline"; } 2>/dev/null | grep -qF -- "$dir/" || return 1
+  echo "$pid"
+}
+
+# Pids of this cluster's job processes: its slurmstepd processes (started by our slurmd, so
+# their environment has SLURM_CONF=$conf) and all their descendants.
+job_pids() {
+  local p s pp roots="" all
+  for p in /proc/[0-9]*; do
+    p=${p#/proc/}
+    [ "$(cat "/proc/$p/comm" 2>/dev/null)" = slurmstepd ] || continue
+    { tr '\0' '\n' <"/proc/$p/environ"; } 2>/dev/null | grep -qxF "SLURM_CONF=$conf" && roots="$roots $p"
+  done
+  [ -z "$roots" ] && return 0
+  # "pid ppid" lines; walk down from the roots.
+  all=$(for p in /proc/[0-9]*/stat; do
+    s=$(cat "$p" 2>/dev/null) || continue
+    s=${s##*) }
+    read -r _ pp _ <<<"$s"
+    p=${p#/proc/}
+    echo "${p%/stat} $pp"
+  done)
+  echo "$all" | awk -v roots="$roots" '
+    { parent[$1] = $2 }
+    END {
+      n = split(roots, r, " "); for (i = 1; i <= n; i++) keep[r[i]] = 1
+      do { changed = 0
+        for (p in parent) if (!(p in keep) && (parent[p] in keep)) { keep[p] = 1; changed = 1 }
+      } while (changed)
+      for (p in keep) print p
+    }'
+}
+
+# Sends TERM to the pids given, waits up to $STOP_WAIT (10) seconds, then KILLs what is left.
+stop_pids() {
+  local p n=0 alive
+  [ $# -eq 0 ] && return 0
+  kill -TERM "$@" 2>/dev/null
+  while :; do
+    alive=""
+    for p in "$@"; do [ -d "/proc/$p" ] && ! grep -q '^State:.*Z' "/proc/$p/status" 2>/dev/null && alive="$alive $p"; done
+    [ -z "$alive" ] && return 0
+    if [ "$n" -ge "$((${STOP_WAIT:-10} * 10))" ]; then
+      log "killing$alive"
+      # shellcheck disable=SC2086
+      kill -KILL $alive 2>/dev/null
+      sleep 0.2
+      return 0
+    fi
+    sleep 0.1
+    n=$((n + 1))
+  done
+}
+
+# Prints the last lines of each log of this cluster (on stderr).
+log_tails() {
+  local f
+  for f in "$dir"/log/munged.log "$dir"/log/slurmctld.log "$dir"/log/slurmd.log; do
+    [ -s "$f" ] || continue
+    echo "---- tail $f" >&2
+    tail -n "${1:-25}" "$f" >&2
+  done
+}
