@@ -1,0 +1,147 @@
+#!/bin/bash
+# A production through a real Slurm (scripts/slurm/start.sh: a private one-node cluster with its
+# own munged, slurmctld and slurmd): `emaki farm submit` of two small shots (160x90, 6 frames,
+# three layers: two temporal, one chunked), waited for with a bounded timeout, and
+#   1. every output file is byte-identical to `emaki run` of the same shot on one machine;
+#   2. a temporal layer task cancelled mid-run (scancel) leaves its dependants unrun, and
+#      submitting again completes the shot to identical outputs;
+#   3. a shot with a bad input (a truncated glTF) fails its task, its compositing never runs,
+#      `emaki farm status` names the failing task and its error line, and the other shot of the
+#      same submission completes.
+# The cluster stops however the test ends. Exits 77 (CTest skip) without Slurm.
+# Usage: farm_slurm_test.sh REPO_ROOT EMAKI_BINARY WORK_DIR
+set -u
+root=$1
+emaki=$2
+work=$3
+for b in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo; do
+  if ! command -v "$b" >/dev/null; then
+    echo "SKIP: '$b' not installed (scripts/setup.sh installs slurm-wlm and munge)"
+    exit 77
+  fi
+done
+
+state=$work/cluster
+failures=0
+fail() {
+  echo "FAIL: $*"
+  failures=$((failures + 1))
+}
+finish() {
+  local rc=$?
+  [ "$failures" -gt 0 ] && rc=1
+  if [ "$rc" -ne 0 ]; then
+    for f in "$work"/*/farm/logs/*.log; do
+      [ -f "$f" ] && { echo "---- $f"; tail -n 5 "$f"; }
+    done
+    [ -f "$state/log/slurmctld.log" ] && { echo "---- slurmctld"; tail -n 20 "$state/log/slurmctld.log"; }
+  fi
+  "$root/scripts/slurm/stop.sh" "$state"
+  exit "$rc"
+}
+trap finish EXIT
+trap 'echo "interrupted"; exit 1' INT TERM
+
+"$root/scripts/slurm/stop.sh" "$state" 2>/dev/null
+rm -rf "$work"
+mkdir -p "$work" || exit 1
+env_line=$("$root/scripts/slurm/start.sh" "$state") || exit 1
+eval "$env_line"
+
+# shot NAME FRAMES SIZE [SCENE]: examples/production/sh010.toml made small, output in $work/NAME.
+shot() {
+  local scene=${4:-$root/examples/data/Fox.glb}
+  sed -e "s|\"../data/Fox.glb\"|\"$scene\"|" -e "s|\"../data/|\"$root/examples/data/|" \
+    -e "s|\"../stylit/|\"$root/examples/stylit/|" -e "s|^frames = .*|frames = [0, $2]|" \
+    -e "s|^size = .*|size = [$3]|" -e "s|^folder = .*|folder = \"$work/$1\"|" \
+    "$root/examples/production/sh010.toml" >"$work/$1.toml"
+}
+
+# Waits (at most $1 s) until the queue is empty.
+wait_queue() {
+  local end=$((SECONDS + $1))
+  while [ -n "$(squeue -h -o %i)" ]; do
+    [ $SECONDS -ge $end ] && { fail "queue not empty after $1 s: $(squeue -h -o '%i %j %T %r' | head)"; return 1; }
+    sleep 0.2
+  done
+}
+
+# The files two output folders must share byte for byte (the farm's own files aside).
+outputs_md5() {
+  (cd "$1" && find . -type f ! -name '.emaki*' ! -path './farm/*' ! -path './passes/*' \
+    -exec md5sum {} + | sort -k 2)
+}
+same_outputs() {
+  local a b
+  a=$(outputs_md5 "$1")
+  b=$(outputs_md5 "$2")
+  [ -n "$a" ] || { fail "$1 holds no outputs"; return; }
+  if [ "$a" = "$b" ]; then
+    echo "identical: $2 = $1 ($(echo "$a" | wc -l) files)"
+  else
+    fail "$2 differs from $1:"
+    diff <(echo "$a") <(echo "$b") | head
+  fi
+}
+
+# --- 1. two shots through Slurm equal `emaki run`
+for s in a b; do
+  shot "$s" 5 "160, 90"
+  sed "s|folder = \"$work/$s\"|folder = \"$work/ref_$s\"|" "$work/$s.toml" >"$work/ref_$s.toml"
+  "$emaki" run "$work/ref_$s.toml" --threads 1 2>/dev/null || fail "emaki run ref_$s"
+done
+t0=$SECONDS
+"$emaki" farm submit "$work/a.toml" "$work/b.toml" --chunk 3 || fail "submit a b"
+wait_queue 300
+echo "two shots through Slurm: $((SECONDS - t0)) s"
+status=$("$emaki" farm status "$work/a.toml" "$work/b.toml" --chunk 3)
+echo "$status" | tail -n 1
+echo "$status" | grep -vE ' done |^[0-9]+ done$' && fail "a task of a or b is not done"
+same_outputs "$work/ref_a" "$work/a"
+same_outputs "$work/ref_b" "$work/b"
+# Submitting a finished shot again submits nothing.
+again=$("$emaki" farm submit "$work/a.toml" --chunk 3 2>&1)
+echo "$again" | grep -q "0 tasks in 0 job arrays submitted" || fail "resubmitting a finished shot: $again"
+
+# --- 2. a temporal layer task cancelled mid-run, then submitted again
+shot c 11 "320, 180"
+sed "s|folder = \"$work/c\"|folder = \"$work/ref_c\"|" "$work/c.toml" >"$work/ref_c.toml"
+"$emaki" run "$work/ref_c.toml" --threads 1 2>/dev/null || fail "emaki run ref_c"
+"$emaki" farm submit "$work/c.toml" --chunk 4 || fail "submit c"
+running=""
+end=$((SECONDS + 120))
+while [ -z "$running" ] && [ $SECONDS -lt $end ]; do
+  running=$("$emaki" farm status "$work/c.toml" --chunk 4 | awk '$1 == "c.layer.base.0-11" && $2 == "running" { print $3 }')
+  [ -z "$running" ] && sleep 0.1
+done
+[ -n "$running" ] || fail "c.layer.base.0-11 never ran"
+sleep 1 # a frame or two into its chain
+scancel "$running"
+echo "cancelled c.layer.base.0-11 (job $running) while it ran"
+wait_queue 120
+status=$("$emaki" farm status "$work/c.toml" --chunk 4)
+echo "$status" | grep '^c.layer.base' | grep -qE 'done' && fail "the cancelled task finished anyway"
+echo "$status" | grep '^c.composite' | grep -q 'done' && fail "compositing ran after a cancelled layer"
+echo "$status" | tail -n 1
+"$emaki" farm submit "$work/c.toml" --chunk 4 || fail "submit c again"
+wait_queue 300
+"$emaki" farm status "$work/c.toml" --chunk 4 | grep -vE ' done |^[0-9]+ done$' && fail "c not done after resubmitting"
+same_outputs "$work/ref_c" "$work/c"
+
+# --- 3. a shot with a bad input beside a good one
+head -c 2000 "$root/examples/data/Fox.glb" >"$work/broken.glb"
+shot bad 5 "160, 90" "$work/broken.glb"
+shot d 5 "160, 90"
+sed "s|folder = \"$work/d\"|folder = \"$work/ref_d\"|" "$work/d.toml" >"$work/ref_d.toml"
+sed -i 's|^start = .*|start = 0.5|' "$work/d.toml" "$work/ref_d.toml"
+"$emaki" run "$work/ref_d.toml" --threads 1 2>/dev/null || fail "emaki run ref_d"
+"$emaki" farm submit "$work/bad.toml" "$work/d.toml" --chunk 3 || fail "submit bad d"
+wait_queue 300
+status=$("$emaki" farm status "$work/bad.toml" "$work/d.toml" --chunk 3)
+echo "$status" | grep '^bad\.'
+echo "$status" | grep -E '^bad\.prepare +failed .*bad.prepare.log: .*error' >/dev/null ||
+  fail "status does not name bad.prepare as failed with its error line"
+echo "$status" | grep -E '^bad\.composite' | grep -vq 'not run' && fail "bad's compositing ran"
+echo "$status" | grep -E '^d\.' | grep -v ' done ' && fail "shot d did not complete beside bad"
+same_outputs "$work/ref_d" "$work/d"
+[ "$failures" -eq 0 ] && echo "PASS"
