@@ -129,8 +129,10 @@ std::string batch_script(const Plan& plan, const std::vector<const Task*>& tasks
   s += "esac\n";
   s += "FARM=" + quoted(farm) + "\n";
   s += "rm -f \"$FARM/status/$TASK.exit\"\n";
+  s += "date +%s.%N >\"$FARM/status/$TASK.start\"\n";
   s += "\"$@\" >\"$FARM/logs/$TASK.log\" 2>&1\n";
   s += "rc=$?\n";
+  s += "date +%s.%N >\"$FARM/status/$TASK.end\"\n";
   s += "echo \"$rc\" >\"$FARM/status/$TASK.exit.tmp\" && mv \"$FARM/status/$TASK.exit.tmp\" "
        "\"$FARM/status/$TASK.exit\"\n";
   s += "exit \"$rc\"\n";
@@ -204,7 +206,11 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
       if (::write(tmp.fd(), script.data(), script.size()) != ssize_t(script.size()))
         throw Error(path, "cannot write the batch script");
       tmp.commit();
-      for (const Task* t : tasks) fs::remove(farm + "/status/" + t->id + ".exit");
+      // A task's record starts afresh: no exit code or log of an earlier submission.
+      for (const Task* t : tasks) {
+        fs::remove(farm + "/status/" + t->id + ".exit");
+        fs::remove(farm + "/logs/" + t->id + ".log");
+      }
       const std::string job = sbatch(path);
       append_jobs(farm, tasks, job);
       for (const Task* t : tasks) job_of_task[t->id] = job;
@@ -253,6 +259,13 @@ TaskStatus status_of(const Plan& plan, const Task& t,
   }
   if (t.done) {
     st.state = TaskState::kDone;
+    return st;
+  }
+  const std::string log = farm + "/logs/" + t.id + ".log";
+  std::error_code ec;
+  if (!st.job.empty() && fs::is_regular_file(log, ec)) {
+    st.state = TaskState::kFailed;
+    st.detail = fmt::format("stopped while running (cancelled or killed); {}", log);
     return st;
   }
   st.state = st.job.empty() ? TaskState::kNotSubmitted : TaskState::kNotRun;
