@@ -7,6 +7,14 @@ dir=$(cd "$dir" && pwd)
 conf=$dir/slurm.conf
 export SLURM_CONF=$conf
 
+# One start.sh or stop.sh at a time per state dir (stop.sh run by a start.sh that holds the
+# lock inherits it).
+if [ "${EMAKI_SLURM_LOCKED:-}" != "$dir" ] && command -v flock >/dev/null; then
+  exec 9>"$dir/lock"
+  flock -w 120 9 || { echo "slurm: $dir/lock held for 120 s by another start.sh/stop.sh" >&2; exit 1; }
+  export EMAKI_SLURM_LOCKED=$dir
+fi
+
 log() { echo "slurm: $*" >&2; }
 
 # Prints the pid in pid file $2 when that process is alive, is the daemon $1 and was started for

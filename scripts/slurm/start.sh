@@ -85,7 +85,7 @@ else
 fi
 chmod 0600 "$key"
 # --force: the state dir may sit under a group-writable path, which munged's checks refuse.
-munged --force --socket="$sock" --key-file="$key" --pid-file="$dir/munged.pid" \
+munged 9>&- --force --socket="$sock" --key-file="$key" --pid-file="$dir/munged.pid" \
   --log-file="$dir/log/munged.log" --seed-file="$run/munge/munged.seed" ||
   fail "munged failed to start"
 for _ in $(seq 50); do
@@ -169,7 +169,7 @@ PartitionName=emaki Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 EOF
 : >"$dir/plugstack.conf"
 
-slurmctld -f "$conf" -i || fail "slurmctld failed to start"
+slurmctld -f "$conf" -i 9>&- || fail "slurmctld failed to start"
 ok=""
 for _ in $(seq $((timeout * 10))); do
   scontrol ping 2>/dev/null | grep -q UP && { ok=1; break; }
@@ -177,7 +177,7 @@ for _ in $(seq $((timeout * 10))); do
 done
 [ -n "$ok" ] || fail "slurmctld does not answer (scontrol ping)"
 
-slurmd -f "$conf" -N localhost || fail "slurmd failed to start"
+slurmd -f "$conf" -N localhost 9>&- || fail "slurmd failed to start"
 state=""
 for _ in $(seq $((timeout * 10))); do
   state=$(sinfo -h -n localhost -o %t 2>/dev/null)
