@@ -22,7 +22,7 @@ done
 m_pid=$(daemon_pid munged "$dir/munged.pid")
 c_pid=$(daemon_pid slurmctld "$dir/slurmctld.pid")
 d_pid=$(daemon_pid slurmd "$dir/slurmd.pid")
-if [ -n "$m_pid" ] && [ -n "$c_pid" ] && [ -n "$d_pid" ]; then
+if [ -n "$m_pid" ] && [ -n "$c_pid" ] && [ -n "$d_pid" ] && [ "$m_pid $c_pid $d_pid" = "${m_pid%% *} ${c_pid%% *} ${d_pid%% *}" ]; then
   case "$(sinfo -h -n localhost -o %t 2>/dev/null)" in
   idle | mix | alloc | comp)
     log "already running in $dir"
