@@ -15,6 +15,10 @@ set -u
 . "$(dirname "$0")/common.sh"
 timeout=${EMAKI_SLURM_START_TIMEOUT:-30}
 
+if [ "$(id -u)" -ne 0 ]; then
+  log "needs root: slurmd starts jobs as their users (SlurmdUser=root)"
+  exit 1
+fi
 for b in munged slurmctld slurmd sbatch sinfo scontrol; do
   command -v "$b" >/dev/null || { log "'$b' not found: install slurm-wlm and munge (scripts/setup.sh)"; exit 1; }
 done
