@@ -7,27 +7,52 @@ dir=$(cd "$dir" && pwd)
 conf=$dir/slurm.conf
 export SLURM_CONF=$conf
 
+# One start.sh or stop.sh at a time per state dir (stop.sh run by a start.sh that holds the
+# lock inherits it).
+if [ "${EMAKI_SLURM_LOCKED:-}" != "$dir" ] && command -v flock >/dev/null; then
+  exec 9>"$dir/lock"
+  flock -w 120 9 || { echo "slurm: $dir/lock held for 120 s by another start.sh/stop.sh" >&2; exit 1; }
+  export EMAKI_SLURM_LOCKED=$dir
+fi
+
 log() { echo "slurm: $*" >&2; }
 
-# Prints the pid in pid file $2 when that process is alive, is the daemon $1 and was started for
-# this state dir (its command line names $dir): a stale or reused pid prints nothing.
+# Prints the pids of daemon $1 (munged, slurmctld or slurmd) started for this state dir: the pid
+# in its pid file $2 when that process is alive and is the daemon, plus any such process whose
+# arguments name this dir's pid file (munged) or slurm.conf (slurmctld, slurmd), so a stale,
+# reused or lost pid file neither hits another process nor loses one of ours.
 daemon_pid() {
-  local pid
-  [ -s "$2" ] || return 1
-  pid=$(tr -dc '0-9' <"$2")
-  [ -n "$pid" ] && [ -d "/proc/$pid" ] || return 1
-  [ "$(cat "/proc/$pid/comm" 2>/dev/null)" = "$1" ] || return 1
-  { tr '\0' ' ' <"/proc/$pid/cmdline"; } 2>/dev/null | grep -qF -- "$dir/" || return 1
-  echo "$pid"
+  local pid="" p want pids=""
+  case "$1" in munged) want="--pid-file=$dir/munged.pid" ;; *) want=$conf ;; esac
+  if [ -s "$2" ]; then
+    pid=$(tr -dc '0-9' <"$2")
+    [ -n "$pid" ] && _is_ours "$pid" "$1" "$want" && pids=$pid
+  fi
+  for p in /proc/[0-9]*; do
+    p=${p#/proc/}
+    [ "$p" = "$pid" ] && continue
+    _is_ours "$p" "$1" "$want" && pids="$pids $p"
+  done
+  # shellcheck disable=SC2086
+  [ -n "$pids" ] && echo $pids
+}
+_is_ours() {
+  local comm=""
+  { read -r comm <"/proc/$1/comm"; } 2>/dev/null
+  [ "$comm" = "$2" ] || return 1
+  grep -q '^State:.*Z' "/proc/$1/status" 2>/dev/null && return 1
+  { tr '\0' '\n' <"/proc/$1/cmdline"; } 2>/dev/null | grep -qxF -- "$3"
 }
 
 # Pids of this cluster's job processes: its slurmstepd processes (started by our slurmd, so
 # their environment has SLURM_CONF=$conf) and all their descendants.
 job_pids() {
-  local p s pp roots="" all
+  local p s pp comm roots="" all
   for p in /proc/[0-9]*; do
     p=${p#/proc/}
-    [ "$(cat "/proc/$p/comm" 2>/dev/null)" = slurmstepd ] || continue
+    comm=""
+    { read -r comm <"/proc/$p/comm"; } 2>/dev/null
+    [ "$comm" = slurmstepd ] || continue
     { tr '\0' '\n' <"/proc/$p/environ"; } 2>/dev/null | grep -qxF "SLURM_CONF=$conf" && roots="$roots $p"
   done
   [ -z "$roots" ] && return 0

@@ -15,6 +15,10 @@ set -u
 . "$(dirname "$0")/common.sh"
 timeout=${EMAKI_SLURM_START_TIMEOUT:-30}
 
+if [ "$(id -u)" -ne 0 ]; then
+  log "needs root: slurmd starts jobs as their users (SlurmdUser=root)"
+  exit 1
+fi
 for b in munged slurmctld slurmd sbatch sinfo scontrol; do
   command -v "$b" >/dev/null || { log "'$b' not found: install slurm-wlm and munge (scripts/setup.sh)"; exit 1; }
 done
@@ -22,7 +26,7 @@ done
 m_pid=$(daemon_pid munged "$dir/munged.pid")
 c_pid=$(daemon_pid slurmctld "$dir/slurmctld.pid")
 d_pid=$(daemon_pid slurmd "$dir/slurmd.pid")
-if [ -n "$m_pid" ] && [ -n "$c_pid" ] && [ -n "$d_pid" ]; then
+if [ -n "$m_pid" ] && [ -n "$c_pid" ] && [ -n "$d_pid" ] && [ "$m_pid $c_pid $d_pid" = "${m_pid%% *} ${c_pid%% *} ${d_pid%% *}" ]; then
   case "$(sinfo -h -n localhost -o %t 2>/dev/null)" in
   idle | mix | alloc | comp)
     log "already running in $dir"
@@ -85,7 +89,7 @@ else
 fi
 chmod 0600 "$key"
 # --force: the state dir may sit under a group-writable path, which munged's checks refuse.
-munged --force --socket="$sock" --key-file="$key" --pid-file="$dir/munged.pid" \
+munged 9>&- --force --socket="$sock" --key-file="$key" --pid-file="$dir/munged.pid" \
   --log-file="$dir/log/munged.log" --seed-file="$run/munge/munged.seed" ||
   fail "munged failed to start"
 for _ in $(seq 50); do
@@ -169,7 +173,7 @@ PartitionName=emaki Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 EOF
 : >"$dir/plugstack.conf"
 
-slurmctld -f "$conf" -i || fail "slurmctld failed to start"
+slurmctld -f "$conf" -i 9>&- || fail "slurmctld failed to start"
 ok=""
 for _ in $(seq $((timeout * 10))); do
   scontrol ping 2>/dev/null | grep -q UP && { ok=1; break; }
@@ -177,7 +181,7 @@ for _ in $(seq $((timeout * 10))); do
 done
 [ -n "$ok" ] || fail "slurmctld does not answer (scontrol ping)"
 
-slurmd -f "$conf" -N localhost || fail "slurmd failed to start"
+slurmd -f "$conf" -N localhost 9>&- || fail "slurmd failed to start"
 state=""
 for _ in $(seq $((timeout * 10))); do
   state=$(sinfo -h -n localhost -o %t 2>/dev/null)

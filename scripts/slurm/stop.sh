@@ -24,11 +24,13 @@ if [ -n "$c_pid" ] && [ -n "$m_pid" ] && [ -f "$conf" ]; then
   fi
 fi
 
-stop_pids ${d_pid:+"$d_pid"}
-stop_pids ${c_pid:+"$c_pid"}
-# shellcheck disable=SC2046
-stop_pids $(job_pids)
-stop_pids ${m_pid:+"$m_pid"}
+# shellcheck disable=SC2046,SC2086
+{
+  stop_pids $d_pid
+  stop_pids $c_pid
+  stop_pids $(job_pids)
+  stop_pids $m_pid
+}
 
 if [ -s "$dir/rundir" ]; then
   case "$(cat "$dir/rundir")" in /tmp/emaki-slurm.*) rm -rf "$(cat "$dir/rundir")" ;; esac
