@@ -62,7 +62,7 @@ uint64_t parse_seed(const std::string& opt, const std::string& v) {
   }
 }
 
-// Walks the argument list; `option` is the one being read.
+// Walks the argument list; args[i] is the option being read.
 struct ArgCursor {
   const std::vector<std::string>& args;
   std::size_t i = 0;
@@ -243,10 +243,10 @@ SynthChannels resolve_channels(const SynthArgs& args, int style_channels,
   for (std::size_t k = 0; k < args.guides.size(); ++k) {
     const SynthGuideArg& g = args.guides[k];
     const auto [source, target] = guide_channels[k];
-    if (source > 4 || target > 4)
-      throw Error(
-          source > 4 ? g.source : g.target,
-          fmt::format("a guide must have 1 to 4 channels (has {})", std::max(source, target)));
+    if (source > 4)
+      throw Error(g.source, fmt::format("a guide must have 1 to 4 channels (has {})", source));
+    if (target > 4)
+      throw Error(g.target, fmt::format("a guide must have 1 to 4 channels (has {})", target));
     const float weight = g.weight >= 0.0f ? g.weight : 1.0f / float(args.guides.size());
     r.guides.push_back({std::max(source, target), weight});
   }

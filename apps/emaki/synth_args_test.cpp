@@ -169,6 +169,7 @@ TEST(SynthChannels, GuideOverFourChannelsNamesTheFile) {
   };
   EXPECT_EQ(error({5, 1}), "c.png: a guide must have 1 to 4 channels (has 5)");
   EXPECT_EQ(error({3, 6}), "d.png: a guide must have 1 to 4 channels (has 6)");
+  EXPECT_EQ(error({5, 6}), "c.png: a guide must have 1 to 4 channels (has 5)");
   EXPECT_EQ(error({4, 4}), "");
 }
 
