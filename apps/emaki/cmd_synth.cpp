@@ -208,6 +208,16 @@ void write_error(const std::string& path, const Image<float>& error) {
   io::write_image(path, error.cview(), o);
 }
 
+// B' as EbSynth writes it, and the extras asked for.
+void write_outputs(const SynthArgs& args, const SynthFiles& files, synth::Result& res) {
+  io::WriteOptions wo;
+  wo.format = output_format(args.depth, files.style.type());
+  const Image<float> out = as_written(std::move(res.image), files.channels.style_channels);
+  io::write_image(args.output, out.cview(), wo);
+  if (!args.nnf_out.empty()) write_nnf(args.nnf_out, res.nnf);
+  if (!args.error_out.empty()) write_error(args.error_out, res.error);
+}
+
 }  // namespace
 
 int run_synth(const Args& argv) {
@@ -223,18 +233,12 @@ int run_synth(const Args& argv) {
   SynthFiles files = load_files(args);
   synth::Result res = run_engine(args, files);
   const auto t1 = std::chrono::steady_clock::now();
-
-  io::WriteOptions wo;
-  wo.format = output_format(args.depth, files.style.type());
-  const int style_channels = files.channels.style_channels;
-  const Image<float> out = as_written(std::move(res.image), style_channels);
-  io::write_image(args.output, out.cview(), wo);
-  if (!args.nnf_out.empty()) write_nnf(args.nnf_out, res.nnf);
-  if (!args.error_out.empty()) write_error(args.error_out, res.error);
+  const int width = res.image.width(), height = res.image.height();
+  write_outputs(args, files, res);
   if (!args.quiet)
     std::fprintf(
         stderr, "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
-        out.width(), out.height(), files.style.width(), files.style.height(), style_channels,
+        width, height, files.style.width(), files.style.height(), files.channels.style_channels,
         args.guides.size(), res.pyramid_levels, std::chrono::duration<double>(t1 - t0).count());
   return 0;
 }
