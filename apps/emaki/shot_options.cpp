@@ -34,39 +34,41 @@ struct SubjectTraits {
 };
 
 constexpr SubjectTraits kSceneTraits{
-    "640x360",
-    2,
-    15.0f,
-    89.0f,
-    40.0f,
-    170.0f,
-    "output size WIDTHxHEIGHT, each in [1, 16384]",
-    "automatic camera: degrees above the horizon, [-89, 89]",
-    "vertical field of view, degrees, [1, 170]",
-    "direction towards the key light X,Y,Z, relative to the camera (x right, y up, z towards the "
-    "viewer) unless --light-world",
-    "angular size of the key light in degrees (shadow penumbra), [0, 45]",
-    "no ground plane",
-    "outline width in pixels, [0, 16]; 0 = none",
+    .size = "640x360",
+    .aa = 2,
+    .elevation = 15.0f,
+    .max_elevation = 89.0f,
+    .fov = 40.0f,
+    .max_fov = 170.0f,
+    .size_help = "output size WIDTHxHEIGHT, each in [1, 16384]",
+    .elevation_help = "automatic camera: degrees above the horizon, [-89, 89]",
+    .fov_help = "vertical field of view, degrees, [1, 170]",
+    .light_help =
+        "direction towards the key light X,Y,Z, relative to the camera (x right, y up, z towards "
+        "the viewer) unless --light-world",
+    .softness_help = "angular size of the key light in degrees (shadow penumbra), [0, 45]",
+    .no_ground_help = "no ground plane",
+    .outline_width_help = "outline width in pixels, [0, 16]; 0 = none",
 };
 
 // exemplar::reference_shot's bounds: the sphere seen from at most 80 degrees above or below
 // the horizon, through a field of view of at most 120 degrees.
 constexpr SubjectTraits kReferenceSphereTraits{
-    "1024x768",
-    3,
-    10.0f,
-    80.0f,
-    30.0f,
-    120.0f,
-    "WIDTHxHEIGHT, each in [1, 16384] (ignored with --fit)",
-    "camera degrees above the horizon, [-80, 80]",
-    "vertical field of view, degrees, [1, 120]; small = nearly orthographic",
-    "direction towards the key light X,Y,Z relative to the camera (x right, y up, z towards the "
-    "viewer)",
-    "angular size of the light, degrees, [0, 45]",
-    "no ground plane (and no cast shadow)",
-    "outline width in pixels, [0, 16]",
+    .size = "1024x768",
+    .aa = 3,
+    .elevation = 10.0f,
+    .max_elevation = 80.0f,
+    .fov = 30.0f,
+    .max_fov = 120.0f,
+    .size_help = "WIDTHxHEIGHT, each in [1, 16384] (ignored with --fit)",
+    .elevation_help = "camera degrees above the horizon, [-80, 80]",
+    .fov_help = "vertical field of view, degrees, [1, 120]; small = nearly orthographic",
+    .light_help =
+        "direction towards the key light X,Y,Z relative to the camera (x right, y up, z towards "
+        "the viewer)",
+    .softness_help = "angular size of the light, degrees, [0, 45]",
+    .no_ground_help = "no ground plane (and no cast shadow)",
+    .outline_width_help = "outline width in pixels, [0, 16]",
 };
 
 const SubjectTraits& traits(ShotSubject subject) {
