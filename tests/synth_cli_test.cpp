@@ -168,6 +168,26 @@ TEST_F(SynthCli, SourceGuideSizeDiffersFromStyle) {
                "tgt.png", p("o.png"));
 }
 
+TEST_F(SynthCli, SourceGuideSizeErrorNamesTheSourceFile) {
+  // synth::validate checks the sizes; the CLI gives it both file names.
+  const RunResult r = run("-style " + p("style.png") + " -guide " + p("tgt2.png") + " " +
+                          p("tgt.png") + " -output " + p("o.png"));
+  EXPECT_EQ(r.err.rfind("emaki synth: error: " + p("tgt2.png") +
+                            ": source guide is 56x44 but "
+                            "the style '" +
+                            p("style.png") + "' is 48x40",
+                        0),
+            0u)
+      << r.err;
+}
+
+TEST_F(SynthCli, GuideFileOverFourChannelsIsNamed) {
+  write("tgt5.exr", 56, 44, 5, 6, true);
+  expect_error("-style " + p("style.png") + " -guide " + p("src.png") + " " + p("tgt5.exr") +
+                   " -output " + p("o.png"),
+               "tgt5.exr: a guide must have 1 to 4 channels", p("o.png"));
+}
+
 TEST_F(SynthCli, TargetGuidesOfDifferentSizes) {
   write("tgt_small.png", 50, 44, 1, 9);
   expect_error("-style " + p("style.png") + " -guide " + p("src.png") + " " + p("tgt.png") +

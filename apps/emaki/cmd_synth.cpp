@@ -1,15 +1,12 @@
 // `emaki synth`: guided synthesis from files. Accepts EbSynth's command line unchanged (single-
 // dash options, `-weight` applying to the -style or -guide before it), so scripts that call
 // `ebsynth` switch by changing the program name; adds long options of its own.
-#include <fmt/format.h>
-
+#include <array>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <exception>
-#include <filesystem>
-#include <optional>
 #include <string>
+#include <vector>
 
 #include "apps/emaki/commands.h"
 #include "apps/emaki/synth_args.h"
@@ -63,6 +60,10 @@ synth::Plane plane_of(const io::AnyImage& im) {
   return std::visit([](const auto& i) -> synth::Plane { return i.view(); }, im.image);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Parse: the command line (synth_args.cpp), then every output path, so that an unwritable one
+// fails before any long work.
+
 void check_output_path(const std::string& opt, const std::string& path) {
   try {
     io::check_writable(path);
@@ -71,35 +72,26 @@ void check_output_path(const std::string& opt, const std::string& path) {
   }
 }
 
-}  // namespace
+void check_output_paths(const SynthArgs& args) {
+  check_output_path("-output", args.output);
+  if (!args.nnf_out.empty()) check_output_path("--nnf-out", args.nnf_out);
+  if (!args.error_out.empty()) check_output_path("--error-out", args.error_out);
+}
 
-int run_synth(const Args& argv) {
-  const SynthArgs args = parse_synth_args(argv);
-  if (args.help) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  const std::string& style_path = args.style_path;
-  const std::string& output = args.output;
-  const std::string& mask_path = args.mask_path;
-  const std::string& nnf_out = args.nnf_out;
-  const std::string& error_out = args.error_out;
-  const std::string& depth = args.depth;
-  const std::vector<SynthGuideArg>& guides = args.guides;
-  synth::Params params = args.params;
-  const bool quiet = args.quiet;
+// ---------------------------------------------------------------------------------------------
+// Load: the files, with the channels EbSynth's rules give them. Sizes, channel counts and
+// values are the engine's to check (synth::validate), naming the file each came from.
 
-  // Fail on an unwritable output before any long work.
-  check_output_path("-output", output);
-  if (!nnf_out.empty()) check_output_path("--nnf-out", nnf_out);
-  if (!error_out.empty()) check_output_path("--error-out", error_out);
-  set_thread_count(args.threads);
+struct SynthFiles {
+  SynthChannels channels;  // what EbSynth's rules made of the files
+  io::AnyImage style;
+  std::vector<io::AnyImage> guides;  // source, target, source, target, ... in -guide order
+  io::AnyImage mask;                 // empty without --mask
+};
 
-  const auto t0 = std::chrono::steady_clock::now();
-  // Decode every file at once (PNG decoding is serial per file); report the first failure in
-  // command-line order so the error does not depend on timing.
-  std::vector<std::string> paths{style_path};
-  for (const auto& g : guides) paths.insert(paths.end(), {g.source, g.target});
+// Decodes every file at once (PNG decoding is serial per file); reports the first failure in
+// command-line order so the error does not depend on timing.
+std::vector<io::AnyImage> read_images(const std::vector<std::string>& paths) {
   std::vector<io::AnyImage> files(paths.size());
   std::vector<std::exception_ptr> failures(paths.size());
   parallel_for(int64_t(paths.size()), 1, [&](int64_t a, int64_t b) {
@@ -113,117 +105,141 @@ int run_synth(const Args& argv) {
   });
   for (const auto& f : failures)
     if (f) std::rethrow_exception(f);
-  io::AnyImage style = std::move(files[0]);
-  style = with_channels(std::move(style), effective_channels(style));
-  if (style.channels() > 4) throw Error(style_path, "style must have 1 to 4 channels");
+  return files;
+}
 
-  std::vector<io::AnyImage> loaded;
-  loaded.reserve(guides.size() * 2);
+SynthFiles load_files(const SynthArgs& args) {
+  std::vector<std::string> paths{args.style_path};
+  for (const SynthGuideArg& g : args.guides) paths.insert(paths.end(), {g.source, g.target});
+  std::vector<io::AnyImage> files = read_images(paths);
+  std::vector<std::array<int, 2>> guide_channels;
+  for (std::size_t k = 1; k < files.size(); k += 2)
+    guide_channels.push_back({effective_channels(files[k]), effective_channels(files[k + 1])});
+
+  SynthFiles r;
+  r.channels = resolve_channels(args, effective_channels(files[0]), guide_channels);
+  r.style = with_channels(std::move(files[0]), r.channels.style_channels);
+  for (std::size_t k = 1; k < files.size(); ++k)
+    r.guides.push_back(with_channels(std::move(files[k]), r.channels.guides[(k - 1) / 2].channels));
+  if (!args.mask_path.empty()) r.mask = io::read_image(args.mask_path);
+  return r;
+}
+
+// The engine's view of the files, with the names its errors give.
+synth::Inputs engine_inputs(const SynthArgs& args, const SynthFiles& files) {
   synth::Inputs in;
-  in.style = plane_of(style);
-  in.style_name = style_path;
-  for (std::size_t k = 0; k < guides.size(); ++k) {
-    const SynthGuideArg& g = guides[k];
-    io::AnyImage s = std::move(files[1 + 2 * k]);
-    io::AnyImage t = std::move(files[2 + 2 * k]);
-    if (s.width() != style.width() || s.height() != style.height())
-      throw Error(g.source,
-                  fmt::format("source guide is {}x{} but the style '{}' is {}x{}", s.width(),
-                              s.height(), style_path, style.width(), style.height()));
-    const int nc = std::max(effective_channels(s), effective_channels(t));
-    if (nc > 4) throw Error(g.source, "a guide must have 1 to 4 channels");
-    loaded.push_back(with_channels(std::move(s), std::min(nc, 4)));
-    loaded.push_back(with_channels(std::move(t), std::min(nc, 4)));
-    const io::AnyImage& ls = loaded[loaded.size() - 2];
-    const io::AnyImage& lt = loaded.back();
-    if (ls.channels() != lt.channels())
-      throw Error(g.target, fmt::format("has {} channels but its source guide '{}' has {}",
-                                        lt.channels(), g.source, ls.channels()));
+  in.style = plane_of(files.style);
+  in.style_name = args.style_path;
+  for (std::size_t k = 0; k < args.guides.size(); ++k) {
     synth::GuidePair gp;
-    gp.name = g.target;
-    gp.source = plane_of(ls);
-    gp.target = plane_of(lt);
-    gp.weight = g.weight;
+    gp.name = args.guides[k].target;
+    gp.source_name = args.guides[k].source;
+    gp.source = plane_of(files.guides[2 * k]);
+    gp.target = plane_of(files.guides[2 * k + 1]);
+    gp.weight = files.channels.guides[k].weight;
     in.guides.push_back(gp);
   }
-  // Name the right file when sizes disagree.
-  for (std::size_t k = 1; k < in.guides.size(); ++k)
-    if (synth::plane_width(in.guides[k].target) != synth::plane_width(in.guides[0].target) ||
-        synth::plane_height(in.guides[k].target) != synth::plane_height(in.guides[0].target))
-      throw Error(guides[k].target,
-                  fmt::format("target guide is {}x{} but '{}' is {}x{}",
-                              synth::plane_width(in.guides[k].target),
-                              synth::plane_height(in.guides[k].target), guides[0].target,
-                              synth::plane_width(in.guides[0].target),
-                              synth::plane_height(in.guides[0].target)));
-  io::AnyImage mask;
-  if (!mask_path.empty()) {
-    mask = io::read_image(mask_path);
-    in.target_mask = plane_of(mask);
-    in.target_mask_name = mask_path;
+  if (!args.mask_path.empty()) {
+    in.target_mask = plane_of(files.mask);
+    in.target_mask_name = args.mask_path;
   }
-  params.style_weight = args.style_weight;
+  return in;
+}
 
+// ---------------------------------------------------------------------------------------------
+// Run
+
+synth::Result run_engine(const SynthArgs& args, SynthFiles& files) {
+  synth::Inputs in = engine_inputs(args, files);
+  synth::Params params = args.params;
+  params.style_weight = files.channels.style_weight;
   synth::OutputRequest req;
-  req.nnf = !nnf_out.empty();
-  req.error = !error_out.empty();
+  req.nnf = !args.nnf_out.empty();
+  req.error = !args.error_out.empty();
   synth::Synthesizer synthesizer(in, params);
   // The guides are packed into the engine's features now; free them before the long part.
   in.guides.clear();
-  loaded.clear();
-  loaded.shrink_to_fit();
-  synth::Result res = synthesizer.run(req);
-  const auto t1 = std::chrono::steady_clock::now();
+  files.guides.clear();
+  files.guides.shrink_to_fit();
+  return synthesizer.run(req);
+}
 
+// ---------------------------------------------------------------------------------------------
+// Write
+
+// --output-depth, else the style file's sample type.
+io::SampleFormat output_format(const std::string& depth, io::PixelType style_type) {
+  if (depth == "8") return io::SampleFormat::kU8;
+  if (depth == "16") return io::SampleFormat::kU16;
+  if (depth == "float") return io::SampleFormat::kFloat;
+  if (style_type == io::PixelType::kU8) return io::SampleFormat::kU8;
+  if (style_type == io::PixelType::kU16) return io::SampleFormat::kU16;
+  return io::SampleFormat::kFloat;
+}
+
+// A one-channel style comes out as RGB (plus alpha with a mask), as EbSynth writes it.
+Image<float> as_written(Image<float> image, int style_channels) {
+  if (style_channels != 1 || image.channels() > 2) return image;
+  const bool alpha = image.channels() == 2;
+  Image<float> rgb(image.width(), image.height(), alpha ? 4 : 3);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      for (int c = 0; c < 3; ++c) rgb(x, y, c) = image(x, y, 0);
+      if (alpha) rgb(x, y, 3) = image(x, y, 1);
+    }
+  return rgb;
+}
+
+void write_nnf(const std::string& path, const Image<int32_t>& nnf) {
+  Image<float> f(nnf.width(), nnf.height(), 2);
+  for (int y = 0; y < f.height(); ++y)
+    for (int x = 0; x < f.width(); ++x)
+      for (int c = 0; c < 2; ++c) f(x, y, c) = float(nnf(x, y, c));
+  io::WriteOptions o;
+  o.format = io::SampleFormat::kFloat;
+  o.channel_names = {"nnf.X", "nnf.Y"};
+  io::write_image(path, f.cview(), o);
+}
+
+void write_error(const std::string& path, const Image<float>& error) {
+  io::WriteOptions o;
+  o.format = io::SampleFormat::kFloat;
+  o.channel_names = {"error.Y"};
+  io::write_image(path, error.cview(), o);
+}
+
+// B' as EbSynth writes it, and the extras asked for.
+void write_outputs(const SynthArgs& args, const SynthFiles& files, synth::Result& res) {
   io::WriteOptions wo;
-  if (depth == "8")
-    wo.format = io::SampleFormat::kU8;
-  else if (depth == "16")
-    wo.format = io::SampleFormat::kU16;
-  else if (depth == "float")
-    wo.format = io::SampleFormat::kFloat;
-  else if (style.type() == io::PixelType::kU8)
-    wo.format = io::SampleFormat::kU8;
-  else if (style.type() == io::PixelType::kU16)
-    wo.format = io::SampleFormat::kU16;
-  else
-    wo.format = io::SampleFormat::kFloat;
-  // A one-channel style whose file was RGB is written back as RGB, as EbSynth does.
-  Image<float> out_img;
-  const int ns = synth::plane_channels(in.style);
-  if (ns == 1 && res.image.channels() <= 2) {
-    const bool alpha = res.image.channels() == 2;
-    out_img.reset(res.image.width(), res.image.height(), alpha ? 4 : 3);
-    for (int y = 0; y < res.image.height(); ++y)
-      for (int x = 0; x < res.image.width(); ++x) {
-        for (int c = 0; c < 3; ++c) out_img(x, y, c) = res.image(x, y, 0);
-        if (alpha) out_img(x, y, 3) = res.image(x, y, 1);
-      }
-  } else {
-    out_img = std::move(res.image);
+  wo.format = output_format(args.depth, files.style.type());
+  const Image<float> out = as_written(std::move(res.image), files.channels.style_channels);
+  io::write_image(args.output, out.cview(), wo);
+  if (!args.nnf_out.empty()) write_nnf(args.nnf_out, res.nnf);
+  if (!args.error_out.empty()) write_error(args.error_out, res.error);
+}
+
+}  // namespace
+
+int run_synth(const Args& argv) {
+  const SynthArgs args = parse_synth_args(argv);
+  if (args.help) {
+    std::fputs(kHelp, stdout);
+    return 0;
   }
-  io::write_image(output, out_img.cview(), wo);
-  if (req.nnf) {
-    Image<float> f(res.nnf.width(), res.nnf.height(), 2);
-    for (int y = 0; y < f.height(); ++y)
-      for (int x = 0; x < f.width(); ++x)
-        for (int c = 0; c < 2; ++c) f(x, y, c) = float(res.nnf(x, y, c));
-    io::WriteOptions o;
-    o.format = io::SampleFormat::kFloat;
-    o.channel_names = {"nnf.X", "nnf.Y"};
-    io::write_image(nnf_out, f.cview(), o);
-  }
-  if (req.error) {
-    io::WriteOptions o;
-    o.format = io::SampleFormat::kFloat;
-    o.channel_names = {"error.Y"};
-    io::write_image(error_out, res.error.cview(), o);
-  }
-  if (!quiet)
-    std::fprintf(stderr,
-                 "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
-                 out_img.width(), out_img.height(), style.width(), style.height(), ns,
-                 guides.size(), res.pyramid_levels, std::chrono::duration<double>(t1 - t0).count());
+  check_output_paths(args);
+  set_thread_count(args.threads);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  SynthFiles files = load_files(args);
+  synth::Result res = run_engine(args, files);
+  const auto t1 = std::chrono::steady_clock::now();
+  const int width = res.image.width(), height = res.image.height();
+  write_outputs(args, files, res);
+  if (!args.quiet)
+    std::fprintf(
+        stderr, "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
+        width, height, files.style.width(), files.style.height(), files.channels.style_channels,
+        args.guides.size(), res.pyramid_levels, std::chrono::duration<double>(t1 - t0).count());
   return 0;
 }
 

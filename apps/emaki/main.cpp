@@ -47,9 +47,11 @@ constexpr FieldOption kFieldOptions[] = {
     {"shots", "SHOT"},
 };
 
-std::string error_text(const emaki::Error& e) {
-  for (const FieldOption& f : kFieldOptions)
-    if (e.field() == f.field) return e.respelled(f.option).what();
+// An emaki::Error naming a field is re-spelled as its option; anything else reads as it is.
+std::string error_text(const std::exception& e) {
+  if (const auto* error = dynamic_cast<const emaki::Error*>(&e))
+    for (const FieldOption& f : kFieldOptions)
+      if (error->field() == f.field) return error->respelled(f.option).what();
   return e.what();
 }
 
@@ -98,11 +100,8 @@ int main(int argc, char** argv) {
     if (name != c.name) continue;
     try {
       return c.run(args);
-    } catch (const emaki::Error& e) {
-      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, error_text(e).c_str());
-      return 1;
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, e.what());
+      std::fprintf(stderr, "emaki %s: error: %s\n", c.name, error_text(e).c_str());
       return 1;
     }
   }

@@ -2,6 +2,7 @@
 // tested alone), and EbSynth's channel rules over loaded images.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -45,5 +46,24 @@ int effective_channels(const io::AnyImage& im);
 // Gives an image `channels` channels: keeps the first ones (effective_channels only drops
 // trailing ones), or spreads a gray image over RGB when its partner guide is in colour.
 io::AnyImage with_channels(io::AnyImage im, int channels);
+
+// What EbSynth's command line gives the engine for each input: its channel count and weight.
+// The engine spreads a weight evenly over the input's channels.
+struct SynthChannels {
+  struct Guide {
+    int channels = 0;  // source and target alike: the larger of their effective counts
+    float weight = 0;  // -weight after the -guide, else 1 / number of guides
+  };
+  int style_channels = 0;     // the style's effective count (the engine checks it is 1 to 4)
+  float style_weight = 1.0f;  // -weight after the -style, else 1
+  std::vector<Guide> guides;
+};
+
+// EbSynth's channel rules. `style_channels` and `guide_channels` ({source, target} per -guide,
+// in order) are effective_channels() of the files. A guide pair whose files disagree gets the
+// larger count (a gray side is spread over RGB); a guide file with more than 4 effective
+// channels is an Error naming it.
+SynthChannels resolve_channels(const SynthArgs& args, int style_channels,
+                               const std::vector<std::array<int, 2>>& guide_channels);
 
 }  // namespace emaki::app

@@ -1,6 +1,7 @@
 // What a shot adds to a scene file: camera (fixed, or orbit / dolly / pan over the frame range),
 // a directional key light, an optional ground plane, a background colour, the clip and frame
-// range. Filled by the CLI now and by the shot file later; resolved per frame into a ViewCamera.
+// range. Filled from `emaki render`'s options, a shot file's source.* keys or the reference
+// sphere (exemplar::reference_shot); resolved per frame into a ViewCamera.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -24,9 +25,9 @@ struct CameraSpec {
   float azimuth_deg = 30.0f;    // kAuto: around +Y, 0 = looking from +Z (glTF front)
   float elevation_deg = 15.0f;  // kAuto: above the horizon
   float distance = 0.0f;        // kAuto: 0 = fit the bounds
-  float fov_deg = 40.0f;        // vertical field of view, (0, 170)
+  float fov_deg = 40.0f;        // vertical field of view, degrees; camera_at clamps to [0.1, 170]
   bool orthographic = false;
-  float ortho_height = 0.0f;  // full visible height in scene units; 0 = fit (kAuto)
+  float ortho_height = 0.0f;  // full visible height in scene units; 0 = fit the shot's bounds
   int gltf_node = -1;
   // Motion from the first to the last frame of the range (linear, extrapolated outside it).
   float orbit_deg = 0.0f;  // turn around the target about +Y
@@ -47,7 +48,7 @@ struct LightSpec {
 
 struct GroundSpec {
   bool enabled = true;
-  float size = 0.0f;        // side of the square; 0 = 6x the shot's bounds
+  float size = 0.0f;        // side of the square; 0 = 6x the bounds' larger horizontal side
   float height = 0.0f;      // y of the plane
   bool auto_height = true;  // put it under the lowest point of the shot
   glm::vec3 color{0.8f};    // linear albedo

@@ -141,8 +141,10 @@ void validate(const Inputs& in, const Params& p) {
   std::string first_target;
   for (const auto& g : in.guides) {
     if (plane_width(g.source) != sw || plane_height(g.source) != sh)
-      throw Error(g.name, fmt::format("source guide is {}x{} but the style is {}x{}",
-                                      plane_width(g.source), plane_height(g.source), sw, sh));
+      throw Error(
+          g.source_name.empty() ? g.name : g.source_name,
+          fmt::format("source guide is {}x{} but the style '{}' is {}x{}", plane_width(g.source),
+                      plane_height(g.source), in.style_name, sw, sh));
     if (tw < 0) {
       tw = plane_width(g.target), th = plane_height(g.target);
       first_target = g.name;

@@ -39,6 +39,9 @@ struct GuidePair {
   Plane source;          // A_k, the size of the style exemplar
   Plane target;          // B_k, the size of the output
   float weight = -1.0f;  // >= 0; negative: 1 / number of guides (EbSynth's default)
+  // Names the source in errors about it alone (its size), when it has a name of its own (a
+  // file); empty: `name`.
+  std::string source_name = {};
 };
 
 enum class VoteMode {
