@@ -122,7 +122,7 @@ std::string batch_script(const Plan& plan, const std::vector<const Task*>& tasks
   s += "case \"$SLURM_ARRAY_TASK_ID\" in\n";
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     std::string argv;
-    for (const std::string& a : tasks[i]->argv) argv += " " + quoted(a);
+    for (const std::string& a : tasks[i]->argv) argv += fmt::format(" {}", quoted(a));
     s += fmt::format("  {}) TASK={}; set --{} ;;\n", i, quoted(tasks[i]->id), argv);
   }
   s += "  *) echo \"emaki farm: no task $SLURM_ARRAY_TASK_ID in this array\" >&2; exit 2 ;;\n";

@@ -47,6 +47,7 @@ struct Progress {
   double elapsed_s = 0.0;
 };
 
+// shot::Request extends it (slicing to it is how the shot API hands a request down).
 struct RunOptions {
   int first_frame = -1, last_frame = -1;  // -1: the shot's range
   std::vector<std::string> layers;        // empty: all

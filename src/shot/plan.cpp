@@ -154,10 +154,10 @@ class Planner {
     t.layer = layer;
     t.first_frame = a;
     t.last_frame = b;
-    t.id = ps.name + "." + task_kind_name(kind);
-    if (!layer.empty()) t.id += "." + layer;
+    t.id = fmt::format("{}.{}", ps.name, task_kind_name(kind));
+    if (!layer.empty()) t.id += fmt::format(".{}", layer);
     if (kind == TaskKind::kPasses || kind == TaskKind::kLayer || kind == TaskKind::kComposite)
-      t.id += "." + frames_text(a, b);
+      t.id += fmt::format(".{}", frames_text(a, b));
     t.argv = {o_.emaki, "task", task_kind_name(kind), ps.path};
     if (!layer.empty()) t.argv.insert(t.argv.end(), {"--layer", layer});
     if (kind != TaskKind::kPrepare && kind != TaskKind::kPreviews)

@@ -13,8 +13,11 @@ namespace {
 constexpr double kInt32Max = 2147483647.0;
 constexpr double kTwoPow40 = 1099511627776.0;
 
+// Rows name only the members they set; the others keep their defaults, which is what GCC's
+// -Wmissing-field-initializers would warn of on every row.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 // clang-format off
-// long-function: a table, not logic
 constexpr KeySpec kSchema[] = {
     {.key = "threads", .type = "integer", .default_value = "`0`", .lo = 0, .hi = 1024, .meaning = "worker threads, 0 = all cores (results do not depend on it)"},
     {.key = "limits.max_pixels", .type = "integer", .default_value = "`268435456` (2^28)", .lo = 1, .hi = kTwoPow40, .range = "[1, 2^40]", .meaning = "the pixel budget: no image emaki reads or makes (frames, paintings, passes, paper) may hold more pixels; `source.size` is checked against it when the shot loads. `--max-pixels N` on the command line wins over it. See [Limits](#limits)"},
@@ -114,14 +117,16 @@ constexpr KeySpec kSchema[] = {
     {.key = "outputs.crf", .type = "integer", .default_value = "`20`", .lo = 0, .hi = 51, .meaning = "libx264 quality, lower is better"},
 };
 // clang-format on
+#pragma GCC diagnostic pop
 
 std::string number_text(double v) {
   if (v == std::floor(v) && std::abs(v) < 1e7) return fmt::format("{}", int64_t(v));
-  std::string s = fmt::format("{:g}", v);  // 1e+07 reads as 1e7
-  for (const char* from : {"e+0", "e+"})
-    if (const std::size_t at = s.find(from); at != std::string::npos)
-      s.replace(at, std::string(from).size(), "e");
-  return s;
+  // 1e+07 reads as 1e7.
+  const std::string g = fmt::format("{:g}", v);
+  const std::size_t e = g.find("e+");
+  if (e == std::string::npos) return g;
+  const std::size_t digits = g.find_first_not_of('0', e + 2);
+  return fmt::format("{}e{}", g.substr(0, e), g.substr(digits));
 }
 
 std::string range_text(const KeySpec& k) {

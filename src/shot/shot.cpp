@@ -14,15 +14,8 @@ namespace emaki::shot {
 
 namespace {
 
-pipeline::RunOptions run_options(const Request& r) {
-  pipeline::RunOptions o;
-  o.first_frame = r.first_frame;
-  o.last_frame = r.last_frame;
-  o.layers = r.layers;
-  o.force = r.force;
-  o.composite = r.composite;
-  o.progress = r.progress;
-  return o;
+const pipeline::RunOptions& run_options(const Request& r) {
+  return r;
 }
 
 void use_threads(const pipeline::Shot& shot, const Request& r) {

@@ -21,18 +21,14 @@ pipeline::Shot open(const std::string& path);
 // The same from text; `path` names it in errors and anchors relative paths.
 pipeline::Shot open_text(std::string_view text, const std::string& path);
 
-// Which part of a shot to work on, and how.
-struct Request {
-  int first_frame = -1, last_frame = -1;  // -1: the shot's range (field "frames")
-  std::vector<std::string> layers;        // empty: every layer (field "layers")
-  bool force = false;                     // run: synthesize finished frames again
-  bool previews = true;                   // contact sheet and MP4, as the shot's outputs ask
-  int threads = -1;                       // -1: the shot's `threads`; 0: all cores
-  bool composite = true;                  // run: composite the frames whose layers are done
+// Which part of a shot to work on, and how: the pipeline's run options (frames, field "frames";
+// layers, field "layers"; force; composite; progress) and what the shot module adds.
+struct Request : pipeline::RunOptions {
+  bool previews = true;  // contact sheet and MP4, as the shot's outputs ask
+  int threads = -1;      // -1: the shot's `threads`; 0: all cores
   // A render-farm task beside other tasks of the same shot (shot/plan.h): shares the output
   // folder's lock, leaves clean-up to the prepare task and needs the folder prepared.
   bool farm_task = false;
-  std::function<void(const pipeline::Progress&)> progress;
 };
 
 struct RunResult {
