@@ -8,8 +8,10 @@
 #   local   the plan's tasks run here without a scheduler, stage by stage, as many at once as
 #           there are cores (xargs -P): the same work and the same parallelism, no Slurm
 #   slurm   `emaki farm submit` on the private cluster (scripts/slurm/start.sh), waited for
-# per-task overhead = (slurm - local) / tasks; and from the tasks' own start/end stamps, the mean
-# time from a task's last dependency ending to its start when a CPU was free.
+# The scheduler's per-task overhead: from the tasks' own start/end stamps, the mean time from
+# the end of the stage a task waits for to its start, when a CPU was free. (`local` has a
+# barrier between stages across all shots where Slurm has one per shot, so slurm - local is
+# not an overhead.) Also the CPU-seconds per task kind.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
 emaki=${1:-$root/build/release/apps/emaki/emaki}
@@ -87,7 +89,16 @@ for farm in glob.glob(os.path.join(sys.argv[1], "*", "farm", "status")):
         if not ends: continue
         d = start - max(ends)
         if 0 <= d < 5: lat.append(d)
-print(f"{sum(lat) / len(lat):.2f} s over {len(lat)} tasks" if lat else "n/a")
+print(f"{sum(lat) / len(lat):.2f} s mean over {len(lat)} tasks" if lat else "n/a")
+cpu = {}
+for farm in glob.glob(os.path.join(sys.argv[1], "*", "farm", "status")):
+    for f in glob.glob(os.path.join(farm, "*.start")):
+        end = f[:-6] + ".end"
+        k = os.path.basename(f).split(".")[1]
+        if os.path.exists(end):
+            n, s = cpu.get(k, (0, 0.0))
+            cpu[k] = (n + 1, s + float(open(end).read()) - float(open(f).read()))
+print("task seconds: " + ", ".join(f"{k} {n} x {s / n:.1f} s" for k, (n, s) in sorted(cpu.items())))
 PY
 )
 echo "production: 3 shots, 480x270, 60 frames, 3 layers; $tasks tasks (chunk $chunk), $cores cores"
@@ -95,6 +106,5 @@ printf '%-44s %8.1f s\n' "emaki run of each shot in turn" "$run_s"
 printf '%-44s %8.1f s\n' "plan's tasks here, no scheduler (xargs -P$cores)" "$local_s"
 printf '%-44s %8.1f s\n' "emaki farm submit on Slurm, to all done" "$slurm_s"
 echo "slurm vs emaki run: $(calc "$slurm_s / $run_s")x wall time"
-echo "per-task overhead of Slurm: $(calc "($slurm_s - $local_s) / $tasks") s ((slurm - local) / tasks)"
-echo "dispatch latency after a dependency ends: $latency"
+echo "Slurm's per-task overhead (dispatch after the stage waited for ends): $latency"
 echo "outputs, slurm vs emaki run: $same"
