@@ -162,12 +162,15 @@ void parse_outputs(const Reader& r, const PathContext& ctx, pipeline::Outputs& o
   const std::string folder = r.string("folder", "");
   if (folder.empty()) throw Error("outputs.folder", "is required");
   o.folder = ctx.resolve(folder);
-  o.layer_png = r.boolean("layer_png", o.layer_png);
-  o.composite_png = r.boolean("composite_png", o.composite_png);
-  o.composite_exr = r.boolean("composite_exr", o.composite_exr);
-  o.layered_exr = r.boolean("layered_exr", o.layered_exr);
-  o.mp4 = r.boolean("mp4", o.mp4);
-  o.contact_sheet = r.boolean("contact_sheet", o.contact_sheet);
+  // Which files are written: each key switches one member.
+  using Switch = std::pair<const char*, bool pipeline::Outputs::*>;
+  for (const auto& [key, member] : {Switch{"layer_png", &pipeline::Outputs::layer_png},
+                                    Switch{"composite_png", &pipeline::Outputs::composite_png},
+                                    Switch{"composite_exr", &pipeline::Outputs::composite_exr},
+                                    Switch{"layered_exr", &pipeline::Outputs::layered_exr},
+                                    Switch{"mp4", &pipeline::Outputs::mp4},
+                                    Switch{"contact_sheet", &pipeline::Outputs::contact_sheet}})
+    o.*member = r.boolean(key, o.*member);
   o.crf = r.integer("crf", o.crf);
   if (o.mp4 && !o.composite_png)
     throw Error("outputs.mp4",

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "shot/toml_reader.h"
@@ -73,56 +74,61 @@ TEST(ShotFile, GuidesKeepTheFileOrderAndOrderSortsLayers) {
   EXPECT_FLOAT_EQ(s.layers[0].look.gradient[1].color.g, 0.5f);
 }
 
+// A shot text and the start of the one-line error it must give.
+struct ErrorCase {
+  std::string text;
+  std::string starts_with;
+  std::string contains = "";  // and, when set, a part of it
+};
+
+void expect_errors(const std::vector<ErrorCase>& cases) {
+  for (const ErrorCase& c : cases) {
+    const std::string e = error_of(c.text);
+    EXPECT_EQ(e.rfind(c.starts_with, 0), 0u) << "error: " << e << "\nwanted: " << c.starts_with;
+    if (!c.contains.empty()) {
+      EXPECT_NE(e.find(c.contains), std::string::npos) << e;
+    }
+  }
+}
+
 TEST(ShotFile, ErrorsNameTheKeyPath) {
   const std::string base = "[layers.outline]\nkind = \"outline\"\nexemplar = \"sphere\"\n";
-  EXPECT_EQ(error_of(minimal(base + "wieght = 1\n")).rfind("layers.outline.wieght: unknown key", 0),
-            0u);
-  EXPECT_NE(
-      error_of(minimal(base + "temporal_wieght = 1\n")).find("did you mean 'temporal_weight'"),
-      std::string::npos);
-  EXPECT_EQ(error_of(minimal(base + "opacity = 2\n"))
-                .rfind("layers.outline.opacity: must be in [0, 1]", 0),
-            0u);
-  EXPECT_EQ(error_of(minimal(base + "levels = [0.5, 0.2, 1]\n")).rfind("layers.outline.levels:", 0),
-            0u);
-  EXPECT_EQ(error_of(minimal(base + "guides = { motion = 1 }\n"))
-                .rfind("layers.outline.guides.motion:", 0),
-            0u);
-  EXPECT_EQ(error_of(minimal(base + "gradient = [[0.5, 0, 0, 0], [0.1, 1, 1, 1]]\n"))
-                .rfind("layers.outline.gradient:", 0),
-            0u);
-  EXPECT_EQ(error_of(minimal("[layers.a]\nexemplar = \"sphere\"\n"))
-                .rfind("layers.a.guides: is required", 0),
-            0u);
-  EXPECT_EQ(error_of(minimal("[layers.\"bad name\"]\nkind = \"base\"\nexemplar = \"sphere\"\n"))
-                .rfind("layers.bad name:", 0),
-            0u);
+  expect_errors({
+      {minimal(base + "wieght = 1\n"), "layers.outline.wieght: unknown key"},
+      {minimal(base + "temporal_wieght = 1\n"), "layers.outline.temporal_wieght: unknown key",
+       "did you mean 'temporal_weight'"},
+      {minimal(base + "opacity = 2\n"), "layers.outline.opacity: must be in [0, 1]"},
+      {minimal(base + "levels = [0.5, 0.2, 1]\n"), "layers.outline.levels:"},
+      {minimal(base + "guides = { motion = 1 }\n"), "layers.outline.guides.motion:"},
+      {minimal(base + "gradient = [[0.5, 0, 0, 0], [0.1, 1, 1, 1]]\n"), "layers.outline.gradient:"},
+      {minimal("[layers.a]\nexemplar = \"sphere\"\n"), "layers.a.guides: is required"},
+      {minimal("[layers.\"bad name\"]\nkind = \"base\"\nexemplar = \"sphere\"\n"),
+       "layers.bad name:"},
+  });
 }
 
 TEST(ShotFile, ChannelPresetKeysAreChecked) {
   const std::string layer = "[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n";
   std::string scene = minimal(layer);  // a scene source has no channel preset
   scene.insert(scene.find("size"), "preset = \"blender\"\n");
-  EXPECT_EQ(error_of(scene).rfind("source.preset: applies to a 'sequence' source only", 0), 0u);
   auto sequence = [&](const std::string& keys) {
     std::string text = minimal(layer);
     const std::size_t from = text.find("scene = "), to = text.find("size = [64, 48]\n");
     return text.replace(from, to + 16 - from,
                         "sequence = \"/nonexistent/frame_%04d.exr\"\nframes = [0, 3]\n" + keys);
   };
-  EXPECT_EQ(error_of(sequence("preset = \"maya\"\n")).rfind("source.preset:", 0), 0u);
-  EXPECT_NE(error_of(sequence("preset = \"maya\"\n")).find("blender"), std::string::npos);
-  EXPECT_EQ(error_of(sequence("view_layer = \"RenderLayer\"\n"))
-                .rfind("source.view_layer: applies to preset = \"blender\" only", 0),
-            0u);
-  EXPECT_EQ(error_of(sequence("preset = \"blender\"\nnormals = \"world\"\n"))
-                .rfind("source.normals: applies to preset = \"emaki\" only", 0),
-            0u);
-  EXPECT_EQ(error_of(sequence("up = \"x\"\n")).rfind("source.up:", 0), 0u);
-  // With the keys right, the next error is the missing first frame.
-  EXPECT_EQ(error_of(sequence("preset = \"blender\"\nview_layer = \"RenderLayer\"\n"))
-                .rfind("source.sequence: no such file", 0),
-            0u);
+  expect_errors({
+      {scene, "source.preset: applies to a 'sequence' source only"},
+      {sequence("preset = \"maya\"\n"), "source.preset:", "blender"},
+      {sequence("view_layer = \"RenderLayer\"\n"),
+       "source.view_layer: applies to preset = \"blender\" only"},
+      {sequence("preset = \"blender\"\nnormals = \"world\"\n"),
+       "source.normals: applies to preset = \"emaki\" only"},
+      {sequence("up = \"x\"\n"), "source.up:"},
+      // With the keys right, the next error is the missing first frame.
+      {sequence("preset = \"blender\"\nview_layer = \"RenderLayer\"\n"),
+       "source.sequence: no such file"},
+  });
 }
 
 }  // namespace
