@@ -8,7 +8,6 @@
 //   gltf_animation.cpp  animations
 #pragma once
 
-#include <fmt/format.h>
 #include <tiny_gltf.h>
 
 #include <cfloat>
