@@ -214,18 +214,15 @@ CameraAxes fit_camera_axes(const std::vector<glm::vec3>& world, const std::vecto
   return {glm::vec3(right), glm::vec3(-down), glm::vec3(-forward)};
 }
 
-Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
-                              const std::string& file) {
-  CHECK_EQ(raw.channels, kBlenderChannelCount);
+namespace {
+
+// Per pixel: unpremultiplied values, world position and normal (+Y up, the normal in world
+// space until the camera is known), ids. Fully covered pixels on a grid of `step` are sampled
+// into world_points / pixels for fitting the camera.
+void convert_pixels(ImageView<const float> raw, const Cube& cube, int step, Image<float>& out,
+                    std::vector<glm::vec3>& world_points, std::vector<glm::vec2>& pixels) {
   using namespace render;
   const int w = raw.width, h = raw.height;
-  Image<float> out(w, h, kChannelCount);
-  out.fill(0.0f);
-
-  // Per pixel: unpremultiplied values, world position and normal (+Y up), ids.
-  std::vector<glm::vec3> world_points;
-  std::vector<glm::vec2> pixels;
-  const int step = std::max(1, int(std::sqrt(double(w) * h / 4000.0)));
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const float* r = raw.at(x, y);
@@ -255,15 +252,15 @@ Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
         pixels.push_back({x + 0.5f, y + 0.5f});
       }
     }
-  for (int c = 0; c < 3; ++c)
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) out(x, y, kRestPosition + c) = out(x, y, kPositionNorm + c);
+}
 
-  const CameraAxes cam = fit_camera_axes(world_points, pixels, file);
-  std::vector<glm::vec3> lit_normals;
-  std::vector<float> lit_diffuse;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
+// World normals into the fitted camera's space. Lit, fully covered pixels on the `step` grid are
+// sampled into lit_normals / lit_diffuse for fitting the light.
+void normals_to_camera(const CameraAxes& cam, int step, Image<float>& out,
+                       std::vector<glm::vec3>& lit_normals, std::vector<float>& lit_diffuse) {
+  using namespace render;
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) {
       float* o = out.at(x, y);
       if (o[kAlpha] <= kCovered) continue;
       glm::vec3 nw(o[kNormal], o[kNormal + 1], o[kNormal + 2]);
@@ -276,25 +273,29 @@ Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
         lit_diffuse.push_back(o[kDiffuse]);
       }
     }
+}
 
-  // Cast shadow from the fitted key light (camera space).
-  const glm::vec3 light = fit_light(lit_normals, lit_diffuse);
-  // DiffDir is the light's strength x N.L x visibility: divided by the fitted strength, it is
-  // emaki's diffuse whatever the sun's strength was.
+// DiffDir is the light's strength x N.L x visibility: divided by the fitted light's strength, it
+// is emaki's diffuse whatever the sun's strength was; what N.L leaves unlit is the cast shadow.
+void diffuse_and_shadow(const glm::vec3& light, Image<float>& out) {
+  using namespace render;
   const float strength = glm::length(light);
-  if (strength > 1e-3f)
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        float* o = out.at(x, y);
-        if (o[kAlpha] <= kCovered) continue;
-        const float ndl = glm::dot(glm::vec3(o[kNormal], o[kNormal + 1], o[kNormal + 2]), light);
-        o[kDiffuse] = std::clamp(o[kDiffuse] / strength, 0.0f, 1.0f);
-        if (ndl <= 0.0f) continue;
-        const float vis = std::clamp(o[kDiffuse] * strength / ndl, 0.0f, 1.0f);
-        o[kShadow] = (1.0f - vis) * std::clamp(10.0f * ndl / strength, 0.0f, 1.0f);
-      }
+  if (!(strength > 1e-3f)) return;  // no light found (NaN included)
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) {
+      float* o = out.at(x, y);
+      if (o[kAlpha] <= kCovered) continue;
+      const float ndl = glm::dot(glm::vec3(o[kNormal], o[kNormal + 1], o[kNormal + 2]), light);
+      o[kDiffuse] = std::clamp(o[kDiffuse] / strength, 0.0f, 1.0f);
+      if (ndl <= 0.0f) continue;
+      const float vis = std::clamp(o[kDiffuse] * strength / ndl, 0.0f, 1.0f);
+      o[kShadow] = (1.0f - vis) * std::clamp(10.0f * ndl / strength, 0.0f, 1.0f);
+    }
+}
 
-  // Outline: id changes (not ground against background), depth jumps, creases; both sides.
+// Outline: id changes (not ground against background), depth jumps, creases; both sides.
+void draw_outlines(Image<float>& out) {
+  using namespace render;
   const float crease = std::cos(45.0f * std::numbers::pi_v<float> / 180.0f);
   auto edge = [&](const float* p, const float* q) {
     const bool pc = p[kAlpha] > 0.5f, qc = q[kAlpha] > 0.5f;
@@ -310,12 +311,39 @@ Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
     const glm::vec3 nq(q[kNormal], q[kNormal + 1], q[kNormal + 2]);
     return glm::dot(np, nq) < crease;
   };
+  const int w = out.width(), h = out.height();
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const float* p = out.at(x, y);
       if (x + 1 < w && edge(p, out.at(x + 1, y))) out(x, y, kOutline) = out(x + 1, y, kOutline) = 1;
       if (y + 1 < h && edge(p, out.at(x, y + 1))) out(x, y, kOutline) = out(x, y + 1, kOutline) = 1;
     }
+}
+
+}  // namespace
+
+Image<float> blender_to_emaki(ImageView<const float> raw, const Cube& cube,
+                              const std::string& file) {
+  CHECK_EQ(raw.channels, kBlenderChannelCount);
+  using namespace render;
+  const int w = raw.width, h = raw.height;
+  Image<float> out(w, h, kChannelCount);
+  out.fill(0.0f);
+  std::vector<glm::vec3> world_points;
+  std::vector<glm::vec2> pixels;
+  const int step = std::max(1, int(std::sqrt(double(w) * h / 4000.0)));
+  convert_pixels(raw, cube, step, out, world_points, pixels);
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) out(x, y, kRestPosition + c) = out(x, y, kPositionNorm + c);
+
+  const CameraAxes cam = fit_camera_axes(world_points, pixels, file);
+  std::vector<glm::vec3> lit_normals;
+  std::vector<float> lit_diffuse;
+  normals_to_camera(cam, step, out, lit_normals, lit_diffuse);
+  // Cast shadow from the fitted key light (camera space).
+  diffuse_and_shadow(fit_light(lit_normals, lit_diffuse), out);
+  draw_outlines(out);
   return out;
 }
 

@@ -167,114 +167,162 @@ Image<float> composite_frame(const Shot& shot, ImageView<const float> passes,
   return composite::composite(inputs, paper, passes.width, passes.height);
 }
 
-RunReport run_shot(const Shot& shot, const FrameSource& frames,
-                   const std::map<std::string, ExemplarImages>& exemplars,
-                   const CompositeInputs& ci, Store& store, const RunOptions& o) {
-  int a = 0, b = 0;
-  resolve_range(shot, o, a, b);
-  const std::vector<const Layer*> selected = selected_layers(shot, o.layers);
-  std::vector<PreparedLayer> prepared;
-  for (const Layer* l : selected) prepared.push_back(prepare(*l, exemplars.at(l->exemplar)));
+namespace {
 
-  const int first = shot.source.first_frame;
-  auto needs = [&](const Layer& l, int f) { return (o.force && f >= a) || !store.has_layer(l, f); };
+// A layer's value (or a frame's passes) at one frame, kept for the next frame's temporal chain.
+struct Held {
+  int frame = -1;
+  Image<float> value;
+};
+
+// One run_shot call over frames a..b of the selected layers, and what it carries from each
+// frame to the next: every layer's last value and the last frame's passes.
+class ShotRun {
+ public:
+  ShotRun(const Shot& shot, const FrameSource& frames,
+          const std::map<std::string, ExemplarImages>& exemplars, const CompositeInputs& ci,
+          Store& store, const RunOptions& o)
+      : shot_(shot), frames_(frames), ci_(ci), store_(store), o_(o) {
+    resolve_range(shot, o, a_, b_);
+    selected_ = selected_layers(shot, o.layers);
+    for (const Layer* l : selected_) prepared_.push_back(prepare(*l, exemplars.at(l->exemplar)));
+    first_ = shot.source.first_frame;
+  }
+
+  RunReport run() {
+    const int start = chain_start();
+    report_.first_frame = start;
+    report_.last_frame = b_;
+    for (int f = start; f <= b_; ++f)
+      for (const Layer* l : selected_) total_ += needs(*l, f) ? 1 : 0;
+    t0_ = Clock::now();
+    held_.resize(prepared_.size());
+    for (int f = start; f <= b_; ++f) {
+      std::vector<Held> now(prepared_.size());
+      const bool changed = synthesize_frame(f, now);
+      if (o_.composite && f >= a_ && (changed || o_.force || !store_.has_frame(f)))
+        composite(f, now);
+      for (std::size_t i = 0; i < prepared_.size(); ++i) held_[i] = std::move(now[i]);
+      if (passes_) prev_passes_ = {f, std::move(*passes_)};
+      passes_.reset();
+    }
+    return report_;
+  }
+
+ private:
+  bool needs(const Layer& l, int f) const {
+    return (o_.force && f >= a_) || !store_.has_layer(l, f);
+  }
+
   // The temporal chain continues from the last finished frame: start where the frame before
   // is available.
-  int start = a;
-  for (const Layer* l : selected)
-    if (l->temporal.enabled) {
-      int s = a;
-      while (s > first && !store.has_layer(*l, s - 1)) --s;
-      start = std::min(start, s);
-    }
+  int chain_start() const {
+    int start = a_;
+    for (const Layer* l : selected_)
+      if (l->temporal.enabled) {
+        int s = a_;
+        while (s > first_ && !store_.has_layer(*l, s - 1)) --s;
+        start = std::min(start, s);
+      }
+    return start;
+  }
 
-  RunReport report;
-  report.first_frame = start;
-  report.last_frame = b;
-  int total = 0;
-  for (int f = start; f <= b; ++f)
-    for (const Layer* l : selected) total += needs(*l, f) ? 1 : 0;
-  const Clock::time_point t0 = Clock::now();
-  auto tick = [&](int f, const std::string& layer) {
-    if (!o.progress) return;
+  void tick(int f, const std::string& layer) const {
+    if (!o_.progress) return;
     Progress p;
     p.frame = f;
     p.layer = layer;
-    p.done = report.synthesized;
-    p.total = total;
-    p.elapsed_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    o.progress(p);
-  };
+    p.done = report_.synthesized;
+    p.total = total_;
+    p.elapsed_s = std::chrono::duration<double>(Clock::now() - t0_).count();
+    o_.progress(p);
+  }
 
-  // Per layer: its frame f-1 result once computed or read (index parallel to `prepared`).
-  struct Held {
-    int frame = -1;
-    Image<float> value;
-  };
-  std::vector<Held> held(prepared.size());
-  Held prev_passes;
-  for (int f = start; f <= b; ++f) {
-    std::optional<Image<float>> passes;
-    auto get_passes = [&]() -> const Image<float>& {
-      if (!passes) passes = frames.passes(f);
-      return *passes;
-    };
+  // Frame f's passes, read on first use: a frame whose layers are all finished needs none.
+  const Image<float>& passes(int f) {
+    if (!passes_) passes_ = frames_.passes(f);
+    return *passes_;
+  }
+
+  // Synthesizes the layers frame f still needs into `now` (parallel to prepared_); the others
+  // are read lazily, only if the chain or the composite needs them. True if any was.
+  bool synthesize_frame(int f, std::vector<Held>& now) {
     bool changed = false;
-    std::vector<Held> now(prepared.size());
-    for (std::size_t i = 0; i < prepared.size(); ++i) {
-      const Layer& l = *prepared[i].layer;
+    for (std::size_t i = 0; i < prepared_.size(); ++i) {
+      const Layer& l = *prepared_[i].layer;
       now[i].frame = f;
       if (!needs(l, f)) {
-        ++report.reused;
-        continue;  // read lazily, only if the chain or the composite needs it
+        ++report_.reused;
+        continue;
       }
       const Image<float>* previous = nullptr;
       const Image<float>* previous_passes = nullptr;
-      if (l.temporal.enabled && f > first) {
-        if (held[i].frame != f - 1 || held[i].value.empty()) {
-          held[i].frame = f - 1;
-          held[i].value = store.read_layer(l, f - 1);
+      if (l.temporal.enabled && f > first_) {
+        if (held_[i].frame != f - 1 || held_[i].value.empty()) {
+          held_[i].frame = f - 1;
+          held_[i].value = store_.read_layer(l, f - 1);
         }
-        if (prev_passes.frame != f - 1) prev_passes = {f - 1, frames.passes(f - 1)};
-        previous = &held[i].value;
-        previous_passes = &prev_passes.value;
+        if (prev_passes_.frame != f - 1) prev_passes_ = {f - 1, frames_.passes(f - 1)};
+        previous = &held_[i].value;
+        previous_passes = &prev_passes_.value;
       }
       tick(f, l.name);
       now[i].value =
-          synthesize_layer(prepared[i], get_passes().cview(), f, previous, previous_passes);
-      store.write_layer(l, f, now[i].value.cview());
-      ++report.synthesized;
+          synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes);
+      store_.write_layer(l, f, now[i].value.cview());
+      ++report_.synthesized;
       changed = true;
     }
-    if (o.composite && f >= a && (changed || o.force || !store.has_frame(f))) {
-      bool complete = true;
-      std::vector<Image<float>> read_back;
-      read_back.reserve(shot.layers.size());  // views point into it: no reallocation
-      std::vector<ImageView<const float>> views;
-      for (const Layer& l : shot.layers) {
-        const auto it = std::find_if(prepared.begin(), prepared.end(),
-                                     [&](const PreparedLayer& p) { return p.layer == &l; });
-        if (it != prepared.end() && !now[it - prepared.begin()].value.empty()) {
-          views.push_back(now[it - prepared.begin()].value.cview());
-        } else if (store.has_layer(l, f)) {
-          read_back.push_back(store.read_layer(l, f));
-          views.push_back(read_back.back().cview());
-        } else {
-          complete = false;  // a layer left out with --layers that was never synthesized
-          break;
-        }
-      }
-      if (complete) {
-        tick(f, "");
-        const Image<float> comp = composite_frame(shot, get_passes().cview(), views, ci);
-        store.write_frame(f, comp.cview(), views, get_passes().cview());
-        ++report.composited;
+    return changed;
+  }
+
+  // Composites frame f from every layer of the shot: this frame's new values, else the stored
+  // ones. A layer left out with --layers that was never synthesized leaves the frame alone.
+  void composite(int f, const std::vector<Held>& now) {
+    std::vector<Image<float>> read_back;
+    read_back.reserve(shot_.layers.size());  // views point into it: no reallocation
+    std::vector<ImageView<const float>> views;
+    for (const Layer& l : shot_.layers) {
+      const auto it = std::find_if(prepared_.begin(), prepared_.end(),
+                                   [&](const PreparedLayer& p) { return p.layer == &l; });
+      if (it != prepared_.end() && !now[it - prepared_.begin()].value.empty()) {
+        views.push_back(now[it - prepared_.begin()].value.cview());
+      } else if (store_.has_layer(l, f)) {
+        read_back.push_back(store_.read_layer(l, f));
+        views.push_back(read_back.back().cview());
+      } else {
+        return;
       }
     }
-    for (std::size_t i = 0; i < prepared.size(); ++i) held[i] = std::move(now[i]);
-    if (passes) prev_passes = {f, std::move(*passes)};
+    tick(f, "");
+    const Image<float> comp = composite_frame(shot_, passes(f).cview(), views, ci_);
+    store_.write_frame(f, comp.cview(), views, passes(f).cview());
+    ++report_.composited;
   }
-  return report;
+
+  const Shot& shot_;
+  const FrameSource& frames_;
+  const CompositeInputs& ci_;
+  Store& store_;
+  const RunOptions& o_;
+  int a_ = 0, b_ = 0;  // the requested frames
+  int first_ = 0;      // the shot's first frame
+  std::vector<const Layer*> selected_;
+  std::vector<PreparedLayer> prepared_;  // parallel to selected_
+  RunReport report_;
+  int total_ = 0;  // layer-frames to synthesize
+  Clock::time_point t0_;
+  std::vector<Held> held_;  // parallel to prepared_: each layer's last value
+  Held prev_passes_;
+  std::optional<Image<float>> passes_;  // the current frame's, once read
+};
+
+}  // namespace
+
+RunReport run_shot(const Shot& shot, const FrameSource& frames,
+                   const std::map<std::string, ExemplarImages>& exemplars,
+                   const CompositeInputs& ci, Store& store, const RunOptions& o) {
+  return ShotRun(shot, frames, exemplars, ci, store, o).run();
 }
 
 int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInputs& ci,

@@ -23,6 +23,55 @@ glm::mat4 look_at(const glm::vec3& eye, const glm::vec3& target) {
   const glm::vec3 up = std::abs(fwd.y) > 0.9999f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
   return glm::lookAt(eye, eye + fwd, up);
 }
+
+// A glTF camera: its node's world transform without scale, its projection; the near plane no
+// closer than the shot's scale allows.
+void gltf_camera(const CameraSpec& spec, const Scene& scene, const Pose& pose, float radius,
+                 ViewCamera& cam) {
+  const Node& node = scene.nodes.at(spec.gltf_node);
+  const CameraDef& def = scene.cameras.at(node.camera);
+  glm::mat4 world = pose.world.at(spec.gltf_node);
+  // Drop scale from the node: a camera's frame is rigid.
+  for (int c = 0; c < 3; ++c) world[c] = glm::vec4(glm::normalize(glm::vec3(world[c])), 0.0f);
+  cam.view = glm::inverse(world);
+  cam.perspective = def.perspective;
+  cam.tan_half_fov = std::tan(0.5f * def.yfov);
+  cam.ortho_half_height = def.ymag;
+  cam.znear = std::max(def.znear, radius * 1e-4f);
+}
+
+// The automatic camera's distance from `target` along `dir`: the nearest at which every fit
+// point (or the bounds' eight corners) falls inside 90 % of the frame: a point at depth
+// dist - z needs |x| / depth and |y| / depth small.
+float fit_distance(const CameraSpec& spec, const Bounds& bounds, const glm::vec3& target,
+                   const glm::vec3& dir, float radius, float tan_half_fov, float aspect,
+                   const std::vector<glm::vec3>* fit_points) {
+  const glm::vec3 back = dir;
+  const glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
+  const glm::vec3 up = glm::cross(back, right);
+  const float m = 0.9f;
+  std::vector<glm::vec3> corners;
+  if (!fit_points || fit_points->empty()) {
+    for (int k = 0; k < 8; ++k)
+      corners.emplace_back((k & 1) ? bounds.hi.x : bounds.lo.x, (k & 2) ? bounds.hi.y : bounds.lo.y,
+                           (k & 4) ? bounds.hi.z : bounds.lo.z);
+  }
+  const std::vector<glm::vec3>& points = corners.empty() ? *fit_points : corners;
+  float dist = 0.0f;
+  for (const glm::vec3& c : points) {
+    const glm::vec3 d = c - target;
+    const float z = glm::dot(d, back);
+    float need;
+    if (spec.orthographic) {
+      need = z + radius;
+    } else {
+      need = z + std::max(std::abs(glm::dot(d, right)) / (m * tan_half_fov * aspect),
+                          std::abs(glm::dot(d, up)) / (m * tan_half_fov));
+    }
+    dist = std::max(dist, need);
+  }
+  return std::max(dist, 1e-3f * radius);
+}
 }  // namespace
 
 ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
@@ -33,18 +82,8 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
   cam.shift = spec.shift;
   const glm::vec3 center = bounds.empty() ? glm::vec3(0.0f) : bounds.center();
   const float radius = bounds.empty() ? 1.0f : std::max(1e-6f, 0.5f * glm::length(bounds.size()));
-
   if (spec.mode == CameraSpec::Mode::kGltf) {
-    const Node& node = scene.nodes.at(spec.gltf_node);
-    const CameraDef& def = scene.cameras.at(node.camera);
-    glm::mat4 world = pose.world.at(spec.gltf_node);
-    // Drop scale from the node: a camera's frame is rigid.
-    for (int c = 0; c < 3; ++c) world[c] = glm::vec4(glm::normalize(glm::vec3(world[c])), 0.0f);
-    cam.view = glm::inverse(world);
-    cam.perspective = def.perspective;
-    cam.tan_half_fov = std::tan(0.5f * def.yfov);
-    cam.ortho_half_height = def.ymag;
-    cam.znear = std::max(def.znear, radius * 1e-4f);
+    gltf_camera(spec, scene, pose, radius, cam);
     return cam;
   }
 
@@ -59,41 +98,14 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
     const float az = spec.azimuth_deg * kDeg, el = spec.elevation_deg * kDeg;
     const glm::vec3 dir(std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el));
     float dist = spec.distance;
-    if (dist <= 0.0f && !bounds.empty()) {
-      // The nearest distance at which every fit point (or the bounds' eight corners) falls inside
-      // 90 % of the frame: a point at depth dist - z needs |x| / depth and |y| / depth small.
-      const glm::vec3 back = dir;
-      const glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
-      const glm::vec3 up = glm::cross(back, right);
-      const float m = 0.9f;
-      std::vector<glm::vec3> corners;
-      if (!fit_points || fit_points->empty()) {
-        for (int k = 0; k < 8; ++k)
-          corners.emplace_back((k & 1) ? bounds.hi.x : bounds.lo.x,
-                               (k & 2) ? bounds.hi.y : bounds.lo.y,
-                               (k & 4) ? bounds.hi.z : bounds.lo.z);
-      }
-      const std::vector<glm::vec3>& points = corners.empty() ? *fit_points : corners;
-      dist = 0.0f;
-      for (const glm::vec3& c : points) {
-        const glm::vec3 d = c - target;
-        const float z = glm::dot(d, back);
-        float need;
-        if (spec.orthographic) {
-          need = z + radius;
-        } else {
-          need = z + std::max(std::abs(glm::dot(d, right)) / (m * cam.tan_half_fov * aspect),
-                              std::abs(glm::dot(d, up)) / (m * cam.tan_half_fov));
-        }
-        dist = std::max(dist, need);
-      }
-      dist = std::max(dist, 1e-3f * radius);
-    } else if (dist <= 0.0f) {
+    if (dist <= 0.0f && !bounds.empty())
+      dist = fit_distance(spec, bounds, target, dir, radius, cam.tan_half_fov, aspect, fit_points);
+    else if (dist <= 0.0f)
       dist = 1.05f * radius / std::sin(half_fov);
-    }
     eye = target + dist * dir;
   }
 
+  // Orbit, dolly and pan run linearly over the frame range.
   const float span = float(std::max(1, shot.last_frame - shot.first_frame));
   const float u =
       shot.last_frame > shot.first_frame ? (frame - float(shot.first_frame)) / span : 0.0f;

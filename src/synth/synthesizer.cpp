@@ -410,33 +410,25 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
   }
 }
 
-Result Synthesizer::run(const OutputRequest& request) {
-  State& st = *state_;
-  CHECK(!st.ran);  // the pyramid is consumed by a run
-  st.ran = true;
-  const Params& params = st.params;
-  const FeatureLayout& layout = st.layout;
-  const int ns = layout.style_channels;
-  const int p = params.patch_size, r = p / 2, border = st.border;
-  const int tw = st.tw, th = st.th, levels = st.levels;
-  const PatchSsdFn ssd = best_patch_ssd();
-  std::vector<Level>& pyr = st.pyr;
-  const std::vector<LevelSchedule>& schedule = st.schedule;
+namespace {
 
-  // The coarse levels come from the finest features, built here rather than in the constructor
-  // so that the caller has already freed the guide images.
-  for (int l = 1; l < levels; ++l) {
+// Levels 1.. of the pyramid, each from the one finer: features by halving, the style from the
+// input (level 1) or by halving, the target mask by halving.
+void build_coarse_levels(std::vector<Level>& pyr, const Plane& style, int sw, int sh,
+                         const FeatureLayout& layout, int border) {
+  const int ns = layout.style_channels;
+  for (std::size_t l = 1; l < pyr.size(); ++l) {
     Level& c = pyr[l];
     const Level& f = pyr[l - 1];
     c.src = downsample(f.src.cview());
     decimate_channels(f.src.cview(), c.src, 0, ns);
     c.src_style.reset(c.src.width(), c.src.height(), ns);
     if (l == 1) {
-      for_each_row(st.style, 0, st.sh, [&](int y, const float* row) {
+      for_each_row(style, 0, sh, [&](int y, const float* row) {
         if (y % 2 != 0 || y / 2 >= c.src_style.height()) return;
         for (int x = 0; x < c.src_style.width(); ++x)
           for (int k = 0; k < ns; ++k)
-            c.src_style(x, y / 2, k) = row[std::min(2 * x, st.sw - 1) * ns + k];
+            c.src_style(x, y / 2, k) = row[std::min(2 * x, sw - 1) * ns + k];
       });
     } else {
       decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
@@ -450,14 +442,41 @@ Result Synthesizer::run(const OutputRequest& request) {
     pad_replicate(c.tgt, border, ns, layout.channels);
     if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
   }
+}
 
+// The coarse-to-fine solve: the nearest-neighbour field, its patch errors and the voted style,
+// carried from each level to the next finer one.
+struct Solve {
+  const Params& params;
+  const FeatureLayout& layout;
+  const Plane& input_style;  // the finest level votes from the input itself
+  int border;
+  PatchSsdFn ssd;
   Image<int32_t> nnf;
   Image<float> err;
   Image<float> style;
-  auto source_style = [&](const Level& L, int l) -> Plane {
-    return l == 0 ? st.style : Plane(L.src_style.cview());
-  };
-  auto run_level = [&](Level& L, int l, int step, const LevelSchedule& sch, int patch,
+
+  Plane source_style(const Level& L, int l) const {
+    return l == 0 ? input_style : Plane(L.src_style.cview());
+  }
+
+  // The level's starting field (identity or random at the coarsest level, the coarser field
+  // upscaled below it) and a plain vote from it, so the first search sees a target style.
+  void start_level(Level& L, int l, bool coarsest) {
+    const int p = params.patch_size, r = p / 2;
+    if (coarsest)
+      nnf = params.init == FieldInit::kIdentity
+                ? identity_nnf(L.tw, L.th, L.sw, L.sh, r)
+                : random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
+    else
+      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
+    err.reset(L.tw, L.th, 1);
+    vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
+    write_style(style, layout, L.tgt, border);
+  }
+
+  // The schedule's search-vote iterations at one level; `step` seeds them.
+  void search_and_vote(Level& L, int l, int step, const LevelSchedule& sch, int patch,
                        float uniformity) {
     PatchMatchLevel pm{L.sw, L.sh, L.tw, L.th, border, &L.src, &L.tgt, &L.active, &nnf, &err};
     if (err.width() != L.tw || err.height() != L.th) err.reset(L.tw, L.th, 1);
@@ -475,63 +494,84 @@ Result Synthesizer::run(const OutputRequest& request) {
       vote(source_style(L, l), nnf, err, L.active, patch, params.vote_mode, style);
       write_style(style, layout, L.tgt, border);
     }
-  };
+  }
+};
 
+// The voted style, with the target mask as an alpha channel (and zero colour where it is 0)
+// when there is one.
+Image<float> output_image(const Image<float>& style, const std::optional<Plane>& mask, int ns,
+                          int tw, int th) {
+  Image<float> image(tw, th, ns + (mask ? 1 : 0));
+  parallel_rows(th, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < tw; ++x)
+        for (int c = 0; c < ns; ++c) image(x, y, c) = style(x, y, c);
+    if (!mask) return;
+    const int mc = plane_channels(*mask);
+    for_each_row(*mask, y0, y1, [&](int y, const float* row) {
+      for (int x = 0; x < tw; ++x) {
+        const float a = std::clamp(row[x * mc], 0.0f, 1.0f);
+        image(x, y, ns) = a;
+        if (a <= 0.0f)
+          for (int c = 0; c < ns; ++c) image(x, y, c) = 0.0f;
+      }
+    });
+  });
+  return image;
+}
+
+// The final field with -1 where the target is outside its (dilated) mask.
+Image<int32_t> active_nnf(const Image<int32_t>& nnf, const Image<uint8_t>& active, int tw, int th) {
+  Image<int32_t> out(tw, th, 2);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      const bool act = active.empty() || active(x, y);
+      out(x, y, 0) = act ? nnf(x, y, 0) : -1;
+      out(x, y, 1) = act ? nnf(x, y, 1) : -1;
+    }
+  return out;
+}
+
+}  // namespace
+
+Result Synthesizer::run(const OutputRequest& request) {
+  State& st = *state_;
+  CHECK(!st.ran);  // the pyramid is consumed by a run
+  st.ran = true;
+  const Params& params = st.params;
+  const int p = params.patch_size, levels = st.levels;
+  std::vector<Level>& pyr = st.pyr;
+  const std::vector<LevelSchedule>& schedule = st.schedule;
+
+  // The coarse levels come from the finest features, built here rather than in the constructor
+  // so that the caller has already freed the guide images.
+  build_coarse_levels(pyr, st.style, st.sw, st.sh, st.layout, st.border);
+
+  Solve solve{params, st.layout, st.style, st.border, best_patch_ssd(), {}, {}, {}};
   for (int l = levels - 1; l >= 0; --l) {
     Level& L = pyr[l];
     if (params.progress) params.progress(levels - 1 - l, levels);
-    if (l == levels - 1)
-      nnf = params.init == FieldInit::kIdentity
-                ? identity_nnf(L.tw, L.th, L.sw, L.sh, r)
-                : random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
-    else
-      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
-    err.reset(L.tw, L.th, 1);
-    vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
-    write_style(style, layout, L.tgt, border);
-    run_level(L, l, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
+    solve.start_level(L, l, l == levels - 1);
+    solve.search_and_vote(L, l, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
     if (l > 0) pyr[l] = Level();  // free the coarse level
   }
-  if (params.extra_pass_3x3) run_level(pyr[0], 0, levels, schedule.back(), 3, 0.0f);
+  if (params.extra_pass_3x3) solve.search_and_vote(pyr[0], 0, levels, schedule.back(), 3, 0.0f);
 
   Result res;
   res.pyramid_levels = levels;
   res.schedule = schedule;
   const Level& F = pyr[0];
-  const int out_c = ns + (st.mask ? 1 : 0);
-  res.image.reset(tw, th, out_c);
-  parallel_rows(th, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < tw; ++x)
-        for (int c = 0; c < ns; ++c) res.image(x, y, c) = style(x, y, c);
-    if (!st.mask) return;
-    const int mc = plane_channels(*st.mask);
-    for_each_row(*st.mask, y0, y1, [&](int y, const float* row) {
-      for (int x = 0; x < tw; ++x) {
-        const float a = std::clamp(row[x * mc], 0.0f, 1.0f);
-        res.image(x, y, ns) = a;
-        if (a <= 0.0f)
-          for (int c = 0; c < ns; ++c) res.image(x, y, c) = 0.0f;
-      }
-    });
-  });
-  if (request.nnf) {
-    res.nnf.reset(tw, th, 2);
-    for (int y = 0; y < th; ++y)
-      for (int x = 0; x < tw; ++x) {
-        const bool act = F.active.empty() || F.active(x, y);
-        res.nnf(x, y, 0) = act ? nnf(x, y, 0) : -1;
-        res.nnf(x, y, 1) = act ? nnf(x, y, 1) : -1;
-      }
-  }
+  res.image = output_image(solve.style, st.mask, st.layout.style_channels, st.tw, st.th);
+  if (request.nnf) res.nnf = active_nnf(solve.nnf, F.active, st.tw, st.th);
   if (request.error) {
-    PatchMatchLevel pm{F.sw, F.sh, F.tw, F.th, border, &F.src, &F.tgt, &F.active, &nnf, &err};
+    PatchMatchLevel pm{F.sw,   F.sh,   F.tw,      F.th,       st.border,
+                       &F.src, &F.tgt, &F.active, &solve.nnf, &solve.err};
     PatchMatchConfig cfg;
     cfg.patch_size = params.extra_pass_3x3 ? 3 : p;
-    cfg.err_scale = layout.err_scale;
-    cfg.ssd = ssd;
+    cfg.err_scale = st.layout.err_scale;
+    cfg.ssd = solve.ssd;
     compute_errors(pm, cfg);
-    res.error = std::move(err);
+    res.error = std::move(solve.err);
   }
   return res;
 }
