@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -43,73 +44,76 @@ Image<float> load(const std::string& arg) {
   return emaki::io::read_pass_file(arg);
 }
 
-int compare(int argc, char** argv) {
-  if (argc < 4) throw emaki::Error("compare", "needs two pass files");
+// compare's pass limits (--max-normal-deg, --max-position, --min-iou, --max-motion).
+struct Limits {
   double max_normal = INFINITY, max_position = INFINITY, min_iou = 0.0, max_motion = INFINITY;
+};
+
+Limits parse_limits(int argc, char** argv) {
+  Limits l;
   for (int i = 4; i + 1 < argc; i += 2) {
     const std::string opt = argv[i];
     const double v = std::atof(argv[i + 1]);
     if (opt == "--max-normal-deg")
-      max_normal = v;
+      l.max_normal = v;
     else if (opt == "--max-position")
-      max_position = v;
+      l.max_position = v;
     else if (opt == "--min-iou")
-      min_iou = v;
+      l.min_iou = v;
     else if (opt == "--max-motion")
-      max_motion = v;
+      l.max_motion = v;
     else
       throw emaki::Error(opt, "unknown option");
   }
-  const Image<float> a = load(argv[2]), b = load(argv[3]);
-  if (a.width() != b.width() || a.height() != b.height())
-    throw emaki::Error(argv[3], fmt::format("is {}x{}, {} is {}x{}", b.width(), b.height(), argv[2],
-                                            a.width(), a.height()));
-  // A's cube side, for positions as a fraction of the box.
-  const float* p0 = nullptr;
-  double side = 0.0;
-  long both = 0, either = 0, full = 0;
+  return l;
+}
+
+// Sums of per-pixel differences between two pass files.
+struct PassDiff {
+  long both = 0, either = 0, full = 0, line_both = 0, line_either = 0;
   double normal_deg = 0.0, position = 0.0, position_norm = 0.0, depth = 0.0, albedo = 0.0;
   double motion = 0.0, rest = 0.0, diffuse = 0.0, shadow = 0.0;
-  long line_both = 0, line_either = 0;
-  for (int y = 0; y < a.height(); ++y)
-    for (int x = 0; x < a.width(); ++x) {
-      const float* pa = a.at(x, y);
-      const float* pb = b.at(x, y);
-      const bool ca = pa[render::kAlpha] > 0.5f, cb = pb[render::kAlpha] > 0.5f;
-      both += ca && cb;
-      either += ca || cb;
-      const bool line_a = pa[render::kOutline] > 0.5f, line_b = pb[render::kOutline] > 0.5f;
-      line_both += line_a && line_b;
-      line_either += line_a || line_b;
-      if (pa[render::kAlpha] < 0.999f || pb[render::kAlpha] < 0.999f) continue;
-      // A's cube side from any fully covered pixel: position = lo + side * position_norm.
-      if (!p0 && std::abs(pa[render::kPositionNorm] - 0.5f) > 0.1f) p0 = pa;
-      ++full;
-      double dot = 0.0, la = 0.0, lb = 0.0, dp = 0.0, dn = 0.0, dc = 0.0, dr = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        dot += double(pa[render::kNormal + c]) * pb[render::kNormal + c];
-        la += double(pa[render::kNormal + c]) * pa[render::kNormal + c];
-        lb += double(pb[render::kNormal + c]) * pb[render::kNormal + c];
-        dp += std::pow(double(pa[render::kPosition + c]) - pb[render::kPosition + c], 2);
-        dn += std::pow(double(pa[render::kPositionNorm + c]) - pb[render::kPositionNorm + c], 2);
-        dc += std::abs(double(pa[render::kAlbedo + c]) - pb[render::kAlbedo + c]) / 3.0;
-        dr += std::pow(double(pa[render::kRestPosition + c]) - pb[render::kRestPosition + c], 2);
-      }
-      motion += std::hypot(double(pa[render::kMotion]) - pb[render::kMotion],
-                           double(pa[render::kMotion + 1]) - pb[render::kMotion + 1]);
-      rest += std::sqrt(dr);
-      diffuse += std::abs(double(pa[render::kDiffuse]) - pb[render::kDiffuse]);
-      shadow += std::abs(double(pa[render::kShadow]) - pb[render::kShadow]);
-      normal_deg += std::acos(std::clamp(dot / std::sqrt(la * lb + 1e-30), -1.0, 1.0)) * 180.0 /
-                    3.14159265358979;
-      position += std::sqrt(dp);
-      position_norm += std::sqrt(dn);
-      depth += std::abs(double(pa[render::kDepth]) - pb[render::kDepth]) /
-               std::max(1e-6, double(pa[render::kDepth]));
-      albedo += dc;
+
+  void add_coverage(const float* pa, const float* pb) {
+    const bool ca = pa[render::kAlpha] > 0.5f, cb = pb[render::kAlpha] > 0.5f;
+    both += ca && cb;
+    either += ca || cb;
+    const bool line_a = pa[render::kOutline] > 0.5f, line_b = pb[render::kOutline] > 0.5f;
+    line_both += line_a && line_b;
+    line_either += line_a || line_b;
+  }
+  // A pixel fully covered in both.
+  void add_full(const float* pa, const float* pb) {
+    ++full;
+    double dot = 0.0, la = 0.0, lb = 0.0, dp = 0.0, dn = 0.0, dc = 0.0, dr = 0.0;
+    auto sq = [](double v) { return v * v; };
+    for (int c = 0; c < 3; ++c) {
+      dot += double(pa[render::kNormal + c]) * pb[render::kNormal + c];
+      la += sq(pa[render::kNormal + c]);
+      lb += sq(pb[render::kNormal + c]);
+      dp += sq(double(pa[render::kPosition + c]) - pb[render::kPosition + c]);
+      dn += sq(double(pa[render::kPositionNorm + c]) - pb[render::kPositionNorm + c]);
+      dc += std::abs(double(pa[render::kAlbedo + c]) - pb[render::kAlbedo + c]) / 3.0;
+      dr += sq(double(pa[render::kRestPosition + c]) - pb[render::kRestPosition + c]);
     }
-  if (full == 0) throw emaki::Error(argv[2], "no pixel is fully covered in both files");
-  // Two pixels far apart give the cube side: |p - q| = side * |pn - qn|.
+    motion += std::hypot(double(pa[render::kMotion]) - pb[render::kMotion],
+                         double(pa[render::kMotion + 1]) - pb[render::kMotion + 1]);
+    rest += std::sqrt(dr);
+    diffuse += std::abs(double(pa[render::kDiffuse]) - pb[render::kDiffuse]);
+    shadow += std::abs(double(pa[render::kShadow]) - pb[render::kShadow]);
+    normal_deg += std::acos(std::clamp(dot / std::sqrt(la * lb + 1e-30), -1.0, 1.0)) * 180.0 /
+                  std::numbers::pi;
+    position += std::sqrt(dp);
+    position_norm += std::sqrt(dn);
+    depth += std::abs(double(pa[render::kDepth]) - pb[render::kDepth]) /
+             std::max(1e-6, double(pa[render::kDepth]));
+    albedo += dc;
+  }
+};
+
+// A's position cube side (position = lo + side * position_norm), from pixels far apart from a
+// reference pixel p0: |p - q| = side * |pn - qn|.
+double cube_side(const Image<float>& a, const float* p0) {
   double num = 0.0, den = 0.0;
   for (int y = 0; y < a.height(); y += 3)
     for (int x = 0; x < a.width(); x += 3) {
@@ -120,28 +124,50 @@ int compare(int argc, char** argv) {
         den += std::abs(double(pa[render::kPositionNorm + c]) - p0[render::kPositionNorm + c]);
       }
     }
-  side = den > 0.0 ? num / den : 1.0;
-  const double iou = either ? double(both) / double(either) : 1.0;
-  normal_deg /= full;
-  const double pos_frac = position / full / side;
+  return den > 0.0 ? num / den : 1.0;
+}
+
+int compare(int argc, char** argv) {
+  if (argc < 4) throw emaki::Error("compare", "needs two pass files");
+  const Limits lim = parse_limits(argc, argv);
+  const Image<float> a = load(argv[2]), b = load(argv[3]);
+  if (a.width() != b.width() || a.height() != b.height())
+    throw emaki::Error(argv[3], fmt::format("is {}x{}, {} is {}x{}", b.width(), b.height(), argv[2],
+                                            a.width(), a.height()));
+  PassDiff d;
+  const float* p0 = nullptr;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) {
+      const float *pa = a.at(x, y), *pb = b.at(x, y);
+      d.add_coverage(pa, pb);
+      if (pa[render::kAlpha] < 0.999f || pb[render::kAlpha] < 0.999f) continue;
+      if (!p0 && std::abs(pa[render::kPositionNorm] - 0.5f) > 0.1f) p0 = pa;
+      d.add_full(pa, pb);
+    }
+  if (d.full == 0) throw emaki::Error(argv[2], "no pixel is fully covered in both files");
+  const double side = cube_side(a, p0);
+  const long full = d.full;
+  const double iou = d.either ? double(d.both) / double(d.either) : 1.0;
+  const double normal_deg = d.normal_deg / full, pos_frac = d.position / full / side;
   std::printf(
       "pixels covered: both %ld, either %ld; coverage IoU %.4f; over %ld fully covered pixels: "
       "normal mean angle %.3f deg, position mean error %.5f of the box (box side %.4g), "
       "position_norm mean difference %.5f, depth mean relative error %.5f, albedo mean "
       "difference %.4f, motion mean difference %.3f px, rest_position mean difference %.4f, "
       "diffuse mean difference %.4f, shadow mean difference %.4f; outline IoU %.3f\n",
-      both, either, iou, full, normal_deg, pos_frac, side, position_norm / full, depth / full,
-      albedo / full, motion / full, rest / full, diffuse / full, shadow / full,
-      line_either ? double(line_both) / line_either : 1.0);
+      d.both, d.either, iou, full, normal_deg, pos_frac, side, d.position_norm / full,
+      d.depth / full, d.albedo / full, d.motion / full, d.rest / full, d.diffuse / full,
+      d.shadow / full, d.line_either ? double(d.line_both) / d.line_either : 1.0);
   bool ok = true;
-  if (normal_deg > max_normal)
-    std::printf("FAIL: normal angle %.3f > %.3f deg\n", normal_deg, max_normal), ok = false;
-  if (pos_frac > max_position)
-    std::printf("FAIL: position error %.5f > %.5f of the box\n", pos_frac, max_position),
+  if (normal_deg > lim.max_normal)
+    std::printf("FAIL: normal angle %.3f > %.3f deg\n", normal_deg, lim.max_normal), ok = false;
+  if (pos_frac > lim.max_position)
+    std::printf("FAIL: position error %.5f > %.5f of the box\n", pos_frac, lim.max_position),
         ok = false;
-  if (motion / full > max_motion)
-    std::printf("FAIL: motion %.3f > %.3f px\n", motion / full, max_motion), ok = false;
-  if (iou < min_iou) std::printf("FAIL: coverage IoU %.4f < %.4f\n", iou, min_iou), ok = false;
+  if (d.motion / full > lim.max_motion)
+    std::printf("FAIL: motion %.3f > %.3f px\n", d.motion / full, lim.max_motion), ok = false;
+  if (iou < lim.min_iou)
+    std::printf("FAIL: coverage IoU %.4f < %.4f\n", iou, lim.min_iou), ok = false;
   return ok ? 0 : 1;
 }
 
