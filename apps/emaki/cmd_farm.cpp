@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdio>
 #include <filesystem>
@@ -155,7 +156,9 @@ int run_task(const Args& args) {
   const std::string usage =
       "usage: emaki task prepare|passes|layer|composite|previews SHOT [--frames A-B] "
       "[--layer NAME] (one task of `emaki plan`)";
-  if (args.empty()) throw Error("", usage);
+  const std::vector<std::string> kinds = {"prepare", "passes", "layer", "composite", "previews"};
+  if (args.empty() || std::find(kinds.begin(), kinds.end(), args[0]) == kinds.end())
+    throw Error("", usage);
   const std::string kind = args[0];
   CLI::App app{
       "One task of a shot's plan, as a farm node runs it beside the shot's other "

@@ -51,6 +51,11 @@ std::string quoted(const std::string& s) {
   return out + "'";
 }
 
+// What a failed command said: its first line of stderr.
+std::string first_line(const std::string& text) {
+  return echo(text.substr(0, text.find('\n')), 300);
+}
+
 // farm/jobs.tsv: "TASK \t JOBID \t INDEX" per submitted task; a later line wins.
 std::map<std::string, std::string> read_jobs(const std::string& folder) {
   std::map<std::string, std::string> jobs;
@@ -77,7 +82,7 @@ void append_jobs(const std::string& folder, const std::vector<const Task*>& task
 std::map<std::string, std::pair<std::string, std::string>> queue() {
   const ProcessResult r = run_process({"squeue", "-h", "-r", "-o", "%i|%T|%r"});
   if (r.exit_code != 0)
-    throw Error("squeue", fmt::format("failed ({}): {}", r.exit_code, echo(r.err, 200)));
+    throw Error("squeue", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
   std::map<std::string, std::pair<std::string, std::string>> q;
   std::istringstream ss(r.out);
   std::string line;
@@ -160,7 +165,7 @@ std::string sbatch(const std::string& script_path) {
   const ProcessResult r = run_process({"sbatch", "--parsable", script_path});
   if (r.exit_code != 0)
     throw Error("sbatch",
-                fmt::format("refused '{}' ({}): {}", script_path, r.exit_code, echo(r.err, 300)));
+                fmt::format("refused '{}' ({}): {}", script_path, r.exit_code, first_line(r.err)));
   std::string id = r.out.substr(0, r.out.find_first_of(";\n"));
   if (id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
     throw Error("sbatch", fmt::format("printed no job id for '{}': {}", script_path, echo(r.out)));
@@ -296,7 +301,7 @@ int cancel(const Plan& plan) {
   argv.insert(argv.end(), ids.begin(), ids.end());
   const ProcessResult r = run_process(argv);
   if (r.exit_code != 0)
-    throw Error("scancel", fmt::format("failed ({}): {}", r.exit_code, echo(r.err, 300)));
+    throw Error("scancel", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
   return int(ids.size());
 }
 
