@@ -21,8 +21,32 @@ int64_t patch_ssd_scalar(const int16_t* a, std::ptrdiff_t a_stride, const int16_
 int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
                        std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound);
 
+// Channel groups, for guides whose weight varies per target pixel: every element of a patch row
+// belongs to one of `groups` groups (`masks` holds `groups` rows of at least `row_elems` int16,
+// row g at masks + g * mask_stride: -1 where the element is in group g, 0 elsewhere), and group
+// g's sum of squared differences counts weights[g] times (1 <= groups <= kMaxChannelGroups).
+// Returns sum_g weights[g] * ssd_g, exact in 64 bits (callers keep weights[g] <= 2^16 and patches
+// below 2^46 per group); stops like PatchSsdFn after any row once that weighted sum exceeds
+// `bound`.
+inline constexpr int kMaxChannelGroups = 8;
+using PatchSsdGroupedFn = int64_t (*)(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                                      std::ptrdiff_t b_stride, int row_elems, int rows,
+                                      int64_t bound, const int16_t* masks,
+                                      std::ptrdiff_t mask_stride, const int64_t* weights,
+                                      int groups);
+
+int64_t patch_ssd_grouped_scalar(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                                 std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound,
+                                 const int16_t* masks, std::ptrdiff_t mask_stride,
+                                 const int64_t* weights, int groups);
+int64_t patch_ssd_grouped_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                               std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound,
+                               const int16_t* masks, std::ptrdiff_t mask_stride,
+                               const int64_t* weights, int groups);
+
 bool cpu_has_avx2();
 // The fastest kernel this CPU runs (EMAKI_SIMD=scalar in the environment forces scalar).
 PatchSsdFn best_patch_ssd();
+PatchSsdGroupedFn best_patch_ssd_grouped();
 
 }  // namespace emaki::synth

@@ -60,4 +60,87 @@ int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t*
   return hsum64(acc64);
 }
 
+namespace {
+
+// The grouped kernel with the group count known at compile time, so the accumulators stay in
+// registers. Each group's differences are its masked copy of the same difference vector.
+template <int G>
+int64_t grouped(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound,
+                const int16_t* masks, std::ptrdiff_t mask_stride, const int64_t* weights) {
+  __m256i acc64[G];
+  for (int g = 0; g < G; ++g) acc64[g] = _mm256_setzero_si256();
+  auto total = [&]() {
+    int64_t s = 0;
+    for (int g = 0; g < G; ++g) s += weights[g] * hsum64(acc64[g]);
+    return s;
+  };
+  for (int j = 0; j < rows; ++j) {
+    const int16_t* pa = a + j * a_stride;
+    const int16_t* pb = b + j * b_stride;
+    __m256i acc32[G];
+    for (int g = 0; g < G; ++g) acc32[g] = _mm256_setzero_si256();
+    int pending = 0;
+    int i = 0;
+    for (; i + 16 <= row_elems; i += 16) {
+      const __m256i va = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pa + i));
+      const __m256i vb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pb + i));
+      const __m256i d = _mm256_sub_epi16(va, vb);
+      for (int g = 0; g < G; ++g) {
+        const __m256i m =
+            _mm256_loadu_si256(reinterpret_cast<const __m256i*>(masks + g * mask_stride + i));
+        const __m256i dg = _mm256_and_si256(d, m);
+        acc32[g] = _mm256_add_epi32(acc32[g], _mm256_madd_epi16(dg, dg));
+      }
+      if (++pending == 3) {
+        for (int g = 0; g < G; ++g) {
+          acc64[g] = widen_add(acc64[g], acc32[g]);
+          acc32[g] = _mm256_setzero_si256();
+        }
+        pending = 0;
+      }
+    }
+    if (i < row_elems) {  // an 8-element tail
+      const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pa + i));
+      const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + i));
+      const __m128i d = _mm_sub_epi16(va, vb);
+      for (int g = 0; g < G; ++g) {
+        const __m128i m =
+            _mm_loadu_si128(reinterpret_cast<const __m128i*>(masks + g * mask_stride + i));
+        const __m128i dg = _mm_and_si128(d, m);
+        const __m256i sq = _mm256_zextsi128_si256(_mm_madd_epi16(dg, dg));
+        if (pending == 3) {
+          acc64[g] = widen_add(acc64[g], acc32[g]);
+          acc32[g] = _mm256_setzero_si256();
+        }
+        acc32[g] = _mm256_add_epi32(acc32[g], sq);
+      }
+    }
+    for (int g = 0; g < G; ++g) acc64[g] = widen_add(acc64[g], acc32[g]);
+    if (j + 1 < rows) {
+      const int64_t s = total();
+      if (s > bound) return s;
+    }
+  }
+  return total();
+}
+
+}  // namespace
+
+int64_t patch_ssd_grouped_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
+                               std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound,
+                               const int16_t* masks, std::ptrdiff_t mask_stride,
+                               const int64_t* weights, int groups) {
+  using Fn = int64_t (*)(const int16_t*, std::ptrdiff_t, const int16_t*, std::ptrdiff_t, int, int,
+                         int64_t, const int16_t*, std::ptrdiff_t, const int64_t*);
+  static constexpr Fn kByCount[kMaxChannelGroups + 1] = {nullptr,    grouped<1>, grouped<2>,
+                                                         grouped<3>, grouped<4>, grouped<5>,
+                                                         grouped<6>, grouped<7>, grouped<8>};
+  if (groups < 1 || groups > kMaxChannelGroups)
+    return patch_ssd_grouped_scalar(a, a_stride, b, b_stride, row_elems, rows, bound, masks,
+                                    mask_stride, weights, groups);
+  return kByCount[groups](a, a_stride, b, b_stride, row_elems, rows, bound, masks, mask_stride,
+                          weights);
+}
+
 }  // namespace emaki::synth

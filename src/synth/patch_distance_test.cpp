@@ -56,5 +56,97 @@ TEST(PatchDistance, ExactForLargestDifferences) {
   }
 }
 
+// Masks for `groups` groups over a pixel of `channels` elements repeated `patch` times: channel c
+// belongs to group group_of[c].
+std::vector<int16_t> group_masks(const std::vector<int>& group_of, int patch, int groups) {
+  const int channels = int(group_of.size()), row_elems = patch * channels;
+  std::vector<int16_t> m(std::size_t(groups) * row_elems, 0);
+  for (int g = 0; g < groups; ++g)
+    for (int i = 0; i < row_elems; ++i)
+      if (group_of[i % channels] == g) m[std::size_t(g) * row_elems + i] = -1;
+  return m;
+}
+
+TEST(PatchDistance, GroupedAvx2EqualsScalar) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  CounterRng rng(11);
+  for (int channels : {8, 16, 24}) {
+    for (int patch : {3, 5, 7}) {
+      for (int groups = 1; groups <= kMaxChannelGroups; ++groups) {
+        std::vector<int> group_of(channels);
+        for (int& g : group_of) g = int(rng.uniform(uint32_t(groups)));
+        const int row_elems = patch * channels;
+        const std::vector<int16_t> masks = group_masks(group_of, patch, groups);
+        const std::ptrdiff_t stride = row_elems + 24;
+        std::vector<int16_t> a(stride * patch), b(stride * patch);
+        for (int trial = 0; trial < 20; ++trial) {
+          for (auto& v : a) v = int16_t(rng.uniform(kQuantMax + 1));
+          for (auto& v : b) v = int16_t(rng.uniform(kQuantMax + 1));
+          int64_t w[kMaxChannelGroups];
+          for (int g = 0; g < groups; ++g)
+            w[g] = trial == 0 ? 65536 : int64_t(rng.uniform(65537));  // 0 .. 2^16
+          const int64_t full = patch_ssd_grouped_scalar(
+              a.data(), stride, b.data(), stride, row_elems, patch,
+              std::numeric_limits<int64_t>::max(), masks.data(), row_elems, w, groups);
+          const int64_t bound = trial % 2 ? full / 3 : std::numeric_limits<int64_t>::max();
+          EXPECT_EQ(patch_ssd_grouped_scalar(a.data(), stride, b.data(), stride, row_elems, patch,
+                                             bound, masks.data(), row_elems, w, groups),
+                    patch_ssd_grouped_avx2(a.data(), stride, b.data(), stride, row_elems, patch,
+                                           bound, masks.data(), row_elems, w, groups))
+              << "channels " << channels << " patch " << patch << " groups " << groups << " trial "
+              << trial;
+        }
+      }
+    }
+  }
+}
+
+// Every group at weight w is the plain distance times w; a group at weight 0 drops out.
+TEST(PatchDistance, GroupedWeightsScaleAndDropGroups) {
+  CounterRng rng(3);
+  const int channels = 8, patch = 5, row_elems = patch * channels;
+  const std::vector<int> group_of = {0, 0, 0, 1, 1, 1, 0, 0};
+  const std::vector<int16_t> masks = group_masks(group_of, patch, 2);
+  std::vector<int16_t> a(row_elems * patch), b(row_elems * patch), b_without(row_elems * patch);
+  for (auto& v : a) v = int16_t(rng.uniform(kQuantMax + 1));
+  for (auto& v : b) v = int16_t(rng.uniform(kQuantMax + 1));
+  for (std::size_t i = 0; i < b.size(); ++i)
+    b_without[i] = group_of[i % channels] == 1 ? a[i] : b[i];  // group 1 equal: no difference
+  const int64_t max = std::numeric_limits<int64_t>::max();
+  const int64_t plain =
+      patch_ssd_scalar(a.data(), row_elems, b.data(), row_elems, row_elems, patch, max);
+  const int64_t base_only =
+      patch_ssd_scalar(a.data(), row_elems, b_without.data(), row_elems, row_elems, patch, max);
+  const int64_t same[2] = {65536, 65536}, drop[2] = {65536, 0};
+  for (PatchSsdGroupedFn fn : {patch_ssd_grouped_scalar, best_patch_ssd_grouped()}) {
+    EXPECT_EQ(fn(a.data(), row_elems, b.data(), row_elems, row_elems, patch, max, masks.data(),
+                 row_elems, same, 2),
+              65536 * plain);
+    EXPECT_EQ(fn(a.data(), row_elems, b.data(), row_elems, row_elems, patch, max, masks.data(),
+                 row_elems, drop, 2),
+              65536 * base_only);
+  }
+}
+
+TEST(PatchDistance, GroupedExactForLargestDifferences) {
+  const int patch = 9, channels = 32, row_elems = patch * channels;
+  std::vector<int> group_of(channels);
+  for (int c = 0; c < channels; ++c) group_of[c] = c % 4;
+  const std::vector<int16_t> masks = group_masks(group_of, patch, 4);
+  std::vector<int16_t> a(row_elems * patch, kQuantMax), b(row_elems * patch, 0);
+  const int64_t w[4] = {65536, 65536, 65536, 65536};
+  const int64_t expect = 65536 * int64_t(patch) * row_elems * int64_t(kQuantMax) * kQuantMax;
+  EXPECT_EQ(
+      patch_ssd_grouped_scalar(a.data(), row_elems, b.data(), row_elems, row_elems, patch,
+                               std::numeric_limits<int64_t>::max(), masks.data(), row_elems, w, 4),
+      expect);
+  if (cpu_has_avx2()) {
+    EXPECT_EQ(
+        patch_ssd_grouped_avx2(a.data(), row_elems, b.data(), row_elems, row_elems, patch,
+                               std::numeric_limits<int64_t>::max(), masks.data(), row_elems, w, 4),
+        expect);
+  }
+}
+
 }  // namespace
 }  // namespace emaki::synth
