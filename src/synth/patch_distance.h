@@ -29,6 +29,7 @@ int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t*
 // below 2^46 per group); stops like PatchSsdFn after any row once that weighted sum exceeds
 // `bound`.
 inline constexpr int kMaxChannelGroups = 8;
+inline constexpr int64_t kGroupWeightOne = int64_t(1) << 16;  // a group's full weight
 using PatchSsdGroupedFn = int64_t (*)(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
                                       std::ptrdiff_t b_stride, int row_elems, int rows,
                                       int64_t bound, const int16_t* masks,

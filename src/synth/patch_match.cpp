@@ -71,7 +71,7 @@ struct Sweep {
   const std::vector<int>& snap_slot;  // target row -> row of snap (-1: not kept)
   float occ_scale;                    // uniformity / (p^2 * omega_best)
   int r;
-  std::ptrdiff_t src_stride, tgt_stride;
+  std::ptrdiff_t src_stride;
   int row_elems;
   double inv_err_scale;
 };
@@ -136,7 +136,7 @@ inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int 
   const int64_t bound_q = bq > 9.0e18 ? std::numeric_limits<int64_t>::max() : int64_t(bq);
   const int16_t* t = L.tgt->at(x + L.border - S.r, y + L.border - S.r);
   const int16_t* s = L.src->at(cx - S.r, cy - S.r);
-  const int64_t ssd = S.C.ssd(t, S.tgt_stride, s, S.src_stride, S.row_elems, 2 * S.r + 1, bound_q);
+  const int64_t ssd = patch_distance(L, S.C, x, y, t, s, S.row_elems, 2 * S.r + 1, bound_q);
   if (ssd > bound_q) return;
   const float new_err = float(double(ssd) * S.C.err_scale);
   if (!(new_err + new_occ < cur_cost)) return;
@@ -261,9 +261,10 @@ void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
           continue;
         }
         const int32_t* m = L.nnf->at(x, y);
-        const int64_t ssd = C.ssd(L.tgt->at(x + L.border - r, y + L.border - r), L.tgt->stride(),
-                                  L.src->at(m[0] - r, m[1] - r), L.src->stride(), row_elems,
-                                  C.patch_size, std::numeric_limits<int64_t>::max());
+        const int64_t ssd =
+            patch_distance(L, C, x, y, L.tgt->at(x + L.border - r, y + L.border - r),
+                           L.src->at(m[0] - r, m[1] - r), row_elems, C.patch_size,
+                           std::numeric_limits<int64_t>::max());
         (*L.err)(x, y) = float(double(ssd) * C.err_scale);
       }
   });
@@ -310,7 +311,6 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
                       occ_scale,
                       p / 2,
                       L.src->stride(),
-                      L.tgt->stride(),
                       p * L.src->channels(),
                       1.0 / C.err_scale};
     parallel_rows(L.th, band, [&](int y0, int y1) {

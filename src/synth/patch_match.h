@@ -36,6 +36,9 @@ struct PatchMatchLevel {
   const Image<uint8_t>* active = nullptr;  // tw x th, or empty: all active
   Image<int32_t>* nnf = nullptr;           // tw x th x 2
   Image<float>* err = nullptr;             // tw x th
+  // With weight maps: tw x th x groups, each target pixel's group weights (group 0, the
+  // channels without a map, at kGroupWeightOne); nullptr or empty: the plain distance.
+  const Image<int64_t>* group_weights = nullptr;
 };
 
 struct PatchMatchConfig {
@@ -46,7 +49,32 @@ struct PatchMatchConfig {
   double err_scale = 1.0;
   uint64_t seed = 1;  // already mixed with the level and search-vote iteration
   PatchSsdFn ssd = nullptr;
+  // With group_weights: the grouped kernel and its masks (groups rows, mask_stride apart, of at
+  // least patch_size x channels elements).
+  PatchSsdGroupedFn ssd_grouped = nullptr;
+  const int16_t* group_masks = nullptr;
+  std::ptrdiff_t group_mask_stride = 0;
+  int groups = 1;
 };
+
+// The distance between the target patch centred at (x, y) (top-left element t) and a source
+// patch (top-left element s), in the level's integer units, stopping above `bound` like the
+// kernels: the plain kernel, or the grouped one at the pixel's group weights.
+inline int64_t patch_distance(const PatchMatchLevel& L, const PatchMatchConfig& C, int x, int y,
+                              const int16_t* t, const int16_t* s, int row_elems, int rows,
+                              int64_t bound) {
+  const std::ptrdiff_t ts = L.tgt->stride(), ss = L.src->stride();
+  if (L.group_weights == nullptr || L.group_weights->empty())
+    return C.ssd(t, ts, s, ss, row_elems, rows, bound);
+  const int64_t* w = L.group_weights->at(x, y);
+  bool full = true;
+  for (int g = 1; g < C.groups; ++g) full = full && w[g] == kGroupWeightOne;
+  // Every group at full weight (most pixels of a typical map): the plain kernel gives the same
+  // sum, scaled, at its speed. Stopping above bound / 2^16 is stopping above bound.
+  if (full) return C.ssd(t, ts, s, ss, row_elems, rows, bound >> 16) << 16;
+  return C.ssd_grouped(t, ts, s, ss, row_elems, rows, bound, C.group_masks, C.group_mask_stride, w,
+                       C.groups);
+}
 
 // Patch error of every active target pixel against its current match, in EbSynth units.
 void compute_errors(const PatchMatchLevel& level, const PatchMatchConfig& config);

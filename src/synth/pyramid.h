@@ -35,7 +35,16 @@ struct FeatureLayout {
   int guide_channels = 0;
   int channels = 0;             // padded to a multiple of 8
   std::vector<ChannelMap> map;  // style then guide channels
-  double err_scale = 1.0;       // EbSynth error = err_scale * sum of squared q differences
+  // EbSynth error = err_scale * distance: the sum of squared q differences, or with weight
+  // maps that sum weighted per channel group in units of 1 / kGroupWeightOne.
+  double err_scale = 1.0;
+  // Channel groups: 1 without weight maps; else group 0 holds the channels without a map and
+  // group k the channels of the k-th guide with one. group_of: per (padded) channel;
+  // group_masks: the grouped kernel's masks, one row of patch_size x channels elements per
+  // group, -1 where the element is in the group.
+  int groups = 1;
+  std::vector<int> group_of;
+  std::vector<int16_t> group_masks;
 };
 
 // Output size of one halving step.

@@ -14,6 +14,7 @@
 #include "synth/patch_match.h"
 #include "synth/pyramid.h"
 #include "synth/voting.h"
+#include "synth/weight_maps.h"
 
 namespace emaki::synth {
 
@@ -169,6 +170,7 @@ void validate(const Inputs& in, const Params& p) {
   if (tw < p.patch_size || th < p.patch_size)
     throw Error(first_target, fmt::format("target {}x{} is smaller than the {}x{} patch", tw, th,
                                           p.patch_size, p.patch_size));
+  check_weight_maps(in, p, tw, th);
   if (in.target_mask) {
     if (plane_width(*in.target_mask) != tw || plane_height(*in.target_mask) != th)
       throw Error(in.target_mask_name,
@@ -216,11 +218,13 @@ namespace {
 
 struct Level {
   int sw = 0, sh = 0, tw = 0, th = 0;
-  Image<int16_t> src;      // sw x sh features
-  Image<int16_t> tgt;      // padded target features
-  Image<float> src_style;  // sw x sh style values for voting (coarse levels; the finest
-                           // votes from the input itself)
-  Image<uint8_t> active;   // tw x th, or empty
+  Image<int16_t> src;            // sw x sh features
+  Image<int16_t> tgt;            // padded target features
+  Image<float> src_style;        // sw x sh style values for voting (coarse levels; the finest
+                                 // votes from the input itself)
+  Image<uint8_t> active;         // tw x th, or empty
+  Image<float> weight_maps;      // tw x th x (groups - 1), with weight maps
+  Image<int64_t> group_weights;  // tw x th x groups, made from them when the level starts
 };
 
 FeatureLayout make_layout(const Inputs& in, const Params& p) {
@@ -266,6 +270,7 @@ FeatureLayout make_layout(const Inputs& in, const Params& p) {
     L.map.push_back(m);
   }
   L.err_scale = 65025.0 * w_max / (double(kQuantMax) * kQuantMax);
+  assign_channel_groups(in, p.patch_size, L);
   return L;
 }
 
@@ -384,6 +389,7 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
       c += plane_channels(g.source);
     }
     pad_replicate(f.tgt, border, ns, layout.channels);
+    if (layout.groups > 1) f.weight_maps = gather_weight_maps(in, tw, th);
     if (in.target_mask) {
       // Synthesize the mask dilated by the patch radius, so pixels at its edge get whole patches.
       Image<uint8_t> inside(tw, th, 1);
@@ -441,6 +447,7 @@ void build_coarse_levels(std::vector<Level>& pyr, const Plane& style, int sw, in
                 c.tgt.at(border, y + border));
     pad_replicate(c.tgt, border, ns, layout.channels);
     if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
+    if (!f.weight_maps.empty()) c.weight_maps = downsample(f.weight_maps.cview());
   }
 }
 
@@ -460,6 +467,22 @@ struct Solve {
     return l == 0 ? input_style : Plane(L.src_style.cview());
   }
 
+  PatchMatchLevel pm_level(const Level& L) {
+    return {L.sw,   L.sh,      L.tw, L.th, border,          &L.src,
+            &L.tgt, &L.active, &nnf, &err, &L.group_weights};
+  }
+  PatchMatchConfig pm_config(int patch) const {
+    PatchMatchConfig cfg;
+    cfg.patch_size = patch;
+    cfg.err_scale = layout.err_scale;
+    cfg.ssd = ssd;
+    cfg.ssd_grouped = best_patch_ssd_grouped();
+    cfg.group_masks = layout.group_masks.data();
+    cfg.group_mask_stride = std::ptrdiff_t(params.patch_size) * layout.channels;
+    cfg.groups = layout.groups;
+    return cfg;
+  }
+
   // The level's starting field (identity or random at the coarsest level, the coarser field
   // upscaled below it) and a plain vote from it, so the first search sees a target style.
   void start_level(Level& L, int l, bool coarsest) {
@@ -471,6 +494,7 @@ struct Solve {
     else
       nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
     err.reset(L.tw, L.th, 1);
+    if (!L.weight_maps.empty()) L.group_weights = quantize_group_weights(L.weight_maps);
     vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
     write_style(style, layout, L.tgt, border);
   }
@@ -478,15 +502,12 @@ struct Solve {
   // The schedule's search-vote iterations at one level; `step` seeds them.
   void search_and_vote(Level& L, int l, int step, const LevelSchedule& sch, int patch,
                        float uniformity) {
-    PatchMatchLevel pm{L.sw, L.sh, L.tw, L.th, border, &L.src, &L.tgt, &L.active, &nnf, &err};
+    const PatchMatchLevel pm = pm_level(L);
     if (err.width() != L.tw || err.height() != L.th) err.reset(L.tw, L.th, 1);
-    PatchMatchConfig cfg;
-    cfg.patch_size = patch;
+    PatchMatchConfig cfg = pm_config(patch);
     cfg.uniformity = uniformity;
     cfg.iterations = sch.patch_match_iters;
     cfg.max_search_radius = sch.max_search_radius;
-    cfg.err_scale = layout.err_scale;
-    cfg.ssd = ssd;
     for (int it = 0; it < sch.search_vote_iters; ++it) {
       cfg.seed = hash_key(params.seed, uint64_t(step), uint64_t(it), uint64_t(patch));
       compute_errors(pm, cfg);
@@ -564,13 +585,7 @@ Result Synthesizer::run(const OutputRequest& request) {
   res.image = output_image(solve.style, st.mask, st.layout.style_channels, st.tw, st.th);
   if (request.nnf) res.nnf = active_nnf(solve.nnf, F.active, st.tw, st.th);
   if (request.error) {
-    PatchMatchLevel pm{F.sw,   F.sh,   F.tw,      F.th,       st.border,
-                       &F.src, &F.tgt, &F.active, &solve.nnf, &solve.err};
-    PatchMatchConfig cfg;
-    cfg.patch_size = params.extra_pass_3x3 ? 3 : p;
-    cfg.err_scale = st.layout.err_scale;
-    cfg.ssd = solve.ssd;
-    compute_errors(pm, cfg);
+    compute_errors(solve.pm_level(F), solve.pm_config(params.extra_pass_3x3 ? 3 : p));
     res.error = std::move(solve.err);
   }
   return res;

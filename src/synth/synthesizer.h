@@ -7,6 +7,12 @@
 // weight_c * (255 * (a_c - b_c))^2 for values in [0, 1], so `uniformity` has EbSynth's meaning.
 // Float guides whose values leave [0, 1] are normalised by their range over source and target.
 //
+// Per-pixel weights. A guide pair may carry a weight map over the target: the guide's share of
+// the error of the patch centred at target pixel p is its weight times map(p) (the map at the
+// patch centre, for every pixel of the patch; docs/temporal.md has the measurement behind that
+// choice). The map's values are quantised to 1/65536 and the weighted sum stays an exact
+// integer; a map of ones gives the same result, bit for bit, as no map.
+//
 // Precision. Each channel is quantised to 16383 * sqrt(weight_c / max_weight) levels over its
 // range (14 bits for the heaviest channel; at least 12 bits for every channel whose weight is
 // at least 1/16 of the heaviest; lighter channels are quantised more coarsely, in proportion to
@@ -42,7 +48,13 @@ struct GuidePair {
   // Names the source in errors about it alone (its size), when it has a name of its own (a
   // file); empty: `name`.
   std::string source_name = {};
+  // Optional per-target-pixel multiplier of `weight`: first channel, the target's size, values
+  // in [0, 1] (0: the guide does not count at that pixel). At most kMaxWeightMaps guides.
+  std::optional<Plane> weight_map = {};
+  std::string weight_map_name = {};  // names the map in errors; empty: `name`
 };
+
+inline constexpr int kMaxWeightMaps = 7;
 
 enum class VoteMode {
   kPlain,     // every overlapping patch counts the same
