@@ -135,6 +135,34 @@ TEST_F(SynthCli, MaskGivesAlpha) {
   EXPECT_EQ(o.value(20, 20, 3), 1.0f);
 }
 
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A white weight map is a weight of 1 everywhere: the same bytes as no map. A black one on the
+// first guide drops it, which changes the output.
+TEST_F(SynthCli, GuideWeightMap) {
+  Image<float> white(56, 44, 1), black(56, 44, 1);
+  white.fill(1.0f);
+  io::write_image(p("white.png"), white.cview());
+  io::write_image(p("black.png"), black.cview());
+  ASSERT_EQ(run(basic() + " -output " + p("plain.png")).exit_code, 0);
+  const RunResult r =
+      run(basic() + " -output " + p("white_out.png") + " --guide-weight-map 1 " + p("white.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(
+      run(basic() + " -output " + p("black_out.png") + " --guide-weight-map 1 " + p("black.png"))
+          .exit_code,
+      0);
+  EXPECT_EQ(file_bytes(p("plain.png")), file_bytes(p("white_out.png")));
+  EXPECT_NE(file_bytes(p("plain.png")), file_bytes(p("black_out.png")));
+  expect_error(basic() + " -output " + p("o.png") + " --guide-weight-map 2 " + p("style.png"),
+               "style.png", p("o.png"));  // 48x40, the output is 56x44
+}
+
 TEST_F(SynthCli, HelpDocumentsEveryOption) {
   const std::string cmd = std::string(EMAKI_BINARY) + " synth --help";
   FILE* f = popen(cmd.c_str(), "r");
@@ -145,7 +173,7 @@ TEST_F(SynthCli, HelpDocumentsEveryOption) {
   for (const char* opt :
        {"-style", "-guide", "-weight", "-output", "-uniformity", "-patchsize", "-pyramidlevels",
         "-searchvoteiters", "-patchmatchiters", "-extrapass3x3", "-backend", "--seed", "--threads",
-        "--mask", "--nnf-out", "--error-out", "Default"})
+        "--mask", "--guide-weight-map", "--nnf-out", "--error-out", "Default"})
     EXPECT_NE(text.find(opt), std::string::npos) << opt;
 }
 

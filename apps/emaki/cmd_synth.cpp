@@ -47,6 +47,9 @@ emaki options
   --threads N           worker threads, >= 0 (0: all cores). Default: 0
   --mask FILE           target mask (first channel > 0 is inside): outside pixels are not
                         synthesized and come out transparent (B' gets an alpha channel)
+  --guide-weight-map N FILE  per-pixel weight of the N-th -guide (from 1): FILE's first
+                        channel, the output's size, values in [0, 1], multiplies the guide's
+                        weight at each output pixel (0: the guide does not count there)
   --vote plain|weighted voting mode. Default: weighted
   --nnf-out FILE        write the nearest-neighbour field (EXR: float x, y of the source patch
                         centre; -1 outside the mask)
@@ -85,8 +88,9 @@ void check_output_paths(const SynthArgs& args) {
 struct SynthFiles {
   SynthChannels channels;  // what EbSynth's rules made of the files
   io::AnyImage style;
-  std::vector<io::AnyImage> guides;  // source, target, source, target, ... in -guide order
-  io::AnyImage mask;                 // empty without --mask
+  std::vector<io::AnyImage> guides;       // source, target, source, target, ... in -guide order
+  std::vector<io::AnyImage> weight_maps;  // per -guide; empty without --guide-weight-map
+  io::AnyImage mask;                      // empty without --mask
 };
 
 // Decodes every file at once (PNG decoding is serial per file); reports the first failure in
@@ -109,9 +113,17 @@ std::vector<io::AnyImage> read_images(const std::vector<std::string>& paths) {
 }
 
 SynthFiles load_files(const SynthArgs& args) {
-  std::vector<std::string> paths{args.style_path};
-  for (const SynthGuideArg& g : args.guides) paths.insert(paths.end(), {g.source, g.target});
+  std::vector<std::string> paths{args.style_path}, map_paths;
+  for (const SynthGuideArg& g : args.guides) {
+    paths.insert(paths.end(), {g.source, g.target});
+    if (!g.weight_map.empty()) map_paths.push_back(g.weight_map);
+  }
+  const std::size_t guide_files = paths.size();
+  paths.insert(paths.end(), map_paths.begin(), map_paths.end());
   std::vector<io::AnyImage> files = read_images(paths);
+  std::vector<io::AnyImage> maps(std::make_move_iterator(files.begin() + guide_files),
+                                 std::make_move_iterator(files.end()));
+  files.resize(guide_files);
   std::vector<std::array<int, 2>> guide_channels;
   for (std::size_t k = 1; k < files.size(); k += 2)
     guide_channels.push_back({effective_channels(files[k]), effective_channels(files[k + 1])});
@@ -121,6 +133,9 @@ SynthFiles load_files(const SynthArgs& args) {
   r.style = with_channels(std::move(files[0]), r.channels.style_channels);
   for (std::size_t k = 1; k < files.size(); ++k)
     r.guides.push_back(with_channels(std::move(files[k]), r.channels.guides[(k - 1) / 2].channels));
+  for (std::size_t k = 0, m = 0; k < args.guides.size(); ++k)
+    r.weight_maps.push_back(args.guides[k].weight_map.empty() ? io::AnyImage()
+                                                              : std::move(maps[m++]));
   if (!args.mask_path.empty()) r.mask = io::read_image(args.mask_path);
   return r;
 }
@@ -137,6 +152,10 @@ synth::Inputs engine_inputs(const SynthArgs& args, const SynthFiles& files) {
     gp.source = plane_of(files.guides[2 * k]);
     gp.target = plane_of(files.guides[2 * k + 1]);
     gp.weight = files.channels.guides[k].weight;
+    if (!args.guides[k].weight_map.empty()) {
+      gp.weight_map = plane_of(files.weight_maps[k]);
+      gp.weight_map_name = args.guides[k].weight_map;
+    }
     in.guides.push_back(gp);
   }
   if (!args.mask_path.empty()) {

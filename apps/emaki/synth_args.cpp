@@ -68,6 +68,8 @@ struct ArgCursor {
   std::size_t i = 0;
   // -weight applies to this: the -style or -guide just before it.
   float* last_weight = nullptr;
+  // --guide-weight-map's (guide number, file), assigned once every -guide is known.
+  std::vector<std::pair<int, std::string>> weight_maps = {};
 
   const std::string& option() const { return args[i]; }
   // The value after the option.
@@ -136,6 +138,19 @@ bool parse_ebsynth_option(ArgCursor& in, SynthArgs& r) {
   return true;
 }
 
+// --guide-weight-map N FILE: the N-th -guide (counting from 1, in command-line order, wherever
+// the option stands) gets a per-pixel weight map. Kept until every -guide is known.
+void parse_guide_weight_map(ArgCursor& in) {
+  const std::string opt = in.option();
+  const std::size_t i = in.i;
+  const std::vector<std::string>& a = in.args;
+  if (i + 2 >= a.size() || a[i + 2].rfind("-", 0) == 0)
+    throw Error(opt, "needs a guide number and a file: --guide-weight-map N FILE");
+  const int n = parse_int_in(opt, a[i + 1], 1, kMaxGuides);
+  in.weight_maps.push_back({n, a[i + 2]});
+  in.i += 2;
+}
+
 // emaki's own options (double dash); false when the current argument is not one of them.
 bool parse_emaki_option(ArgCursor& in, SynthArgs& r) {
   const std::string& a = in.option();
@@ -161,6 +176,8 @@ bool parse_emaki_option(ArgCursor& in, SynthArgs& r) {
     r.depth = in.value();
     if (r.depth != "8" && r.depth != "16" && r.depth != "float")
       throw Error(a, "must be 8, 16 or float (got '" + echo(r.depth) + "')");
+  } else if (a == "--guide-weight-map") {
+    parse_guide_weight_map(in);
   } else if (a == "--quiet") {
     r.quiet = true;
   } else {
@@ -174,7 +191,8 @@ bool parse_emaki_option(ArgCursor& in, SynthArgs& r) {
 SynthArgs parse_synth_args(const std::vector<std::string>& args) {
   SynthArgs r;
   r.guides.reserve(kMaxGuides);
-  for (ArgCursor in{args}; in.i < args.size(); ++in.i) {
+  ArgCursor in{args};
+  for (; in.i < args.size(); ++in.i) {
     const std::string& a = in.option();
     if (a == "--help" || a == "-help" || a == "-h") {
       r.help = true;
@@ -185,6 +203,16 @@ SynthArgs parse_synth_args(const std::vector<std::string>& args) {
   }
   if (r.style_path.empty()) throw Error("-style", "is required (the style exemplar)");
   if (r.guides.empty()) throw Error("-guide", "at least one guide pair is required");
+  for (const auto& [n, file] : in.weight_maps) {
+    if (n > int(r.guides.size()))
+      throw Error("--guide-weight-map",
+                  fmt::format("guide {} does not exist (there {} {})", n,
+                              r.guides.size() == 1 ? "is" : "are", r.guides.size()));
+    std::string& map = r.guides[n - 1].weight_map;
+    if (!map.empty())
+      throw Error("--guide-weight-map", fmt::format("guide {} has two weight maps", n));
+    map = file;
+  }
   return r;
 }
 

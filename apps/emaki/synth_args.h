@@ -13,7 +13,8 @@ namespace emaki::app {
 
 struct SynthGuideArg {
   std::string source, target;
-  float weight = -1.0f;  // -1: EbSynth's default (1 / number of guides)
+  float weight = -1.0f;         // -1: EbSynth's default (1 / number of guides)
+  std::string weight_map = {};  // --guide-weight-map: per-pixel weight over the target, or empty
 };
 
 struct SynthArgs {

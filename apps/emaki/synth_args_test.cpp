@@ -66,6 +66,30 @@ TEST(SynthArgs, ErrorsNameTheOption) {
   EXPECT_EQ(error_of({"-style", "s.png"}).rfind("-guide: at least one", 0), 0u);
 }
 
+TEST(SynthArgs, GuideWeightMapsNameTheirGuide) {
+  const SynthArgs a = parse_synth_args({"--guide-weight-map", "2", "m.png", "-style", "s.png",
+                                        "-guide", "a.png", "b.png", "-guide", "c.png", "d.png"});
+  ASSERT_EQ(a.guides.size(), 2u);
+  EXPECT_EQ(a.guides[0].weight_map, "");
+  EXPECT_EQ(a.guides[1].weight_map, "m.png");
+  const std::vector<std::string> base{"-style", "s.png", "-guide", "a.png", "b.png"};
+  struct Case {
+    std::vector<std::string> extra;
+    std::string starts;
+  } cases[] = {
+      {{"--guide-weight-map", "2", "m.png"}, "--guide-weight-map: guide 2 does not exist"},
+      {{"--guide-weight-map", "0", "m.png"}, "--guide-weight-map: must be in [1, 64]"},
+      {{"--guide-weight-map", "1"}, "--guide-weight-map: needs a guide number and a file"},
+      {{"--guide-weight-map", "1", "m.png", "--guide-weight-map", "1", "n.png"},
+       "--guide-weight-map: guide 1 has two weight maps"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    EXPECT_EQ(error_of(args).rfind(c.starts, 0), 0u) << c.starts << " vs " << error_of(args);
+  }
+}
+
 TEST(SynthArgs, EchoedValuesAreCapped) {
   const std::string huge(1 << 20, 'x');
   const std::string e = error_of({"-style", "s.png", "-guide", "a", "b", "-patchsize", huge});
