@@ -97,7 +97,14 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
   const std::string p = "layers." + layer.name + ".";
   l.add(p + "exemplar", layer.exemplar);
   if (const pipeline::Exemplar* e = shot.find_exemplar(layer.exemplar)) add_exemplar(l, *e);
-  for (const pipeline::GuideSpec& g : layer.guides) l.add(p + "guides." + g.pass, g.weight);
+  for (const pipeline::GuideSpec& g : layer.guides) {
+    l.add(p + "guides." + g.pass, g.weight);
+    if (!g.map_pass.empty()) l.add(p + "guides." + g.pass + ".map", "pass " + g.map_pass);
+    if (!g.map_image.empty()) {
+      l.add(p + "guides." + g.pass + ".map", g.map_image);
+      l.add(p + "guides." + g.pass + ".map.digest", file_digest(g.map_image));
+    }
+  }
   const pipeline::SynthSpec& s = layer.synth;
   l.add(p + "synth", fmt::format("patch {} uniformity {} levels {} search_vote {} "
                                  "patch_match {} seed {}",
@@ -107,6 +114,9 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
   l.add(p + "channel", layer.channel);
   l.add(p + "temporal", fmt::format("{} weight {} guide {}", layer.temporal.enabled,
                                     layer.temporal.weight, int(layer.temporal.guide)));
+  const temporal::ConfidenceParams& c = layer.temporal.confidence_params;
+  l.add(p + "temporal.confidence", fmt::format("{} error {} {} erode {}", layer.temporal.confidence,
+                                               c.error_full, c.error_none, c.erode));
   l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
                                 layer.mask.dilate, layer.mask.threshold));
   return l.m;

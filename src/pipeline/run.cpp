@@ -9,6 +9,7 @@
 #include "composite/composite.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "pipeline/temporal_guide.h"
 #include "render/passes.h"
 #include "synth/synthesizer.h"
 #include "temporal/advection.h"
@@ -23,11 +24,12 @@ using Clock = std::chrono::steady_clock;
 struct PreparedLayer {
   const Layer* layer = nullptr;
   int value_channels = 1;
-  Image<float> style;                       // A': the touch (1 channel) or the painting's RGB
-  std::vector<Image<float>> source_guides;  // one per layer->guides entry
+  Image<float> style;                             // A': the touch (1 channel) or the painting's RGB
+  std::vector<Image<float>> source_guides;        // one per layer->guides entry
+  std::vector<const Image<float>*> painted_maps;  // per guide: its painted weight map, or null
 };
 
-PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex) {
+PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const WeightMapImages& maps) {
   PreparedLayer p;
   p.layer = &layer;
   p.value_channels = layer.single_colour ? 1 : 3;
@@ -39,26 +41,13 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex) {
                   "false needs an RGB painting, its exemplar's painting is grey");
     p.style = extract(ex.painting.cview(), 0, 3);
   }
-  for (const GuideSpec& g : layer.guides)
+  for (const GuideSpec& g : layer.guides) {
     p.source_guides.push_back(extract_pass(ex.passes.cview(), g.pass));
+    const auto it = g.map_image.empty() ? maps.end() : maps.find(g.map_image);
+    CHECK(g.map_image.empty() || it != maps.end());  // shot::load_weight_maps read every one
+    p.painted_maps.push_back(it == maps.end() ? nullptr : &it->second);
+  }
   return p;
-}
-
-synth::Params synth_params(const SynthSpec& s, uint64_t seed) {
-  synth::Params p;
-  p.patch_size = s.patch_size;
-  p.uniformity = s.uniformity;
-  p.pyramid_levels = s.pyramid_levels;
-  p.search_vote_iters = s.search_vote_iters;
-  p.patch_match_iters = s.patch_match_iters;
-  p.seed = seed;
-  return p;
-}
-
-// Seeds depend on (layer seed, frame, which transfer) only, so a resumed run draws exactly the
-// numbers an uninterrupted one would.
-uint64_t frame_seed(const Layer& l, int frame, int transfer) {
-  return hash_key(l.synth.seed, uint64_t(frame), uint64_t(transfer));
 }
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
@@ -77,31 +66,33 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
       return empty;
     }
   }
-  std::vector<Image<float>> targets;
+  std::vector<Image<float>> targets, pass_maps;
+  targets.reserve(l.guides.size());  // views point into them: no reallocation
+  pass_maps.reserve(l.guides.size());
   synth::Inputs inputs;
   inputs.style = p.style.cview();
   inputs.style_name = fmt::format("exemplars.{}.painting", l.exemplar);
   for (std::size_t i = 0; i < l.guides.size(); ++i) {
-    targets.push_back(extract_pass(passes, l.guides[i].pass));
-    inputs.guides.push_back({fmt::format("layers.{}.guides.{}", l.name, l.guides[i].pass),
-                             p.source_guides[i].cview(), targets.back().cview(),
-                             l.guides[i].weight});
+    const GuideSpec& g = l.guides[i];
+    targets.push_back(extract_pass(passes, g.pass));
+    synth::GuidePair pair{fmt::format("layers.{}.guides.{}", l.name, g.pass),
+                          p.source_guides[i].cview(), targets.back().cview(), g.weight};
+    if (!g.map_pass.empty()) {
+      pass_maps.push_back(extract_pass(passes, g.map_pass));
+      pair.weight_map = synth::Plane(pass_maps.back().cview());
+    } else if (p.painted_maps[i]) {
+      pair.weight_map = synth::Plane(p.painted_maps[i]->cview());
+      pair.weight_map_name = g.map_image;
+    }
+    inputs.guides.push_back(pair);
   }
-  Image<float> advected;
+  temporal::Advection advected;
   if (previous && previous_passes) {
-    const Image<float> guide_prev = advection_guide(previous_passes->cview(), l.temporal.guide);
-    const Image<float> guide_cur = advection_guide(passes, l.temporal.guide);
-    temporal::AdvectionInputs a;
-    a.previous_stylized = previous->cview();
-    a.value_channels = n;
-    a.previous_guide = guide_prev.cview();
-    a.current_guide = guide_cur.cview();
-    a.guide_name =
-        l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
-    if (!mask.empty()) a.current_mask = mask.cview();
-    advected = temporal::advect(a, synth_params(l.synth, frame_seed(l, frame, 1)));
-    inputs.guides.push_back({fmt::format("layers.{}.temporal", l.name), p.style.cview(),
-                             advected.cview(), l.temporal.weight});
+    advected = advect_layer(l, passes, mask, previous->cview(), previous_passes->cview(), frame);
+    synth::GuidePair pair{fmt::format("layers.{}.temporal", l.name), p.style.cview(),
+                          advected.value.cview(), l.temporal.weight};
+    if (!advected.confidence.empty()) pair.weight_map = synth::Plane(advected.confidence.cview());
+    inputs.guides.push_back(pair);
   }
   if (!mask.empty()) inputs.target_mask = mask.cview();
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
@@ -109,7 +100,7 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
   // search-vote iteration at the finest level instead of two keeps flicker and the judge's
   // style energy within their bars (measured on the example, docs/temporal.md) and saves about
   // a quarter of the time per frame.
-  if (!advected.empty()) params.finest_search_vote_iters = 1;
+  if (!advected.value.empty()) params.finest_search_vote_iters = 1;
   synth::Result r = synth::synthesize(inputs, params);
   return std::move(r.image);
 }
@@ -181,11 +172,12 @@ class ShotRun {
  public:
   ShotRun(const Shot& shot, const FrameSource& frames,
           const std::map<std::string, ExemplarImages>& exemplars, const CompositeInputs& ci,
-          Store& store, const RunOptions& o)
+          Store& store, const RunOptions& o, const WeightMapImages& maps)
       : shot_(shot), frames_(frames), ci_(ci), store_(store), o_(o) {
     resolve_range(shot, o, a_, b_);
     selected_ = selected_layers(shot, o.layers);
-    for (const Layer* l : selected_) prepared_.push_back(prepare(*l, exemplars.at(l->exemplar)));
+    for (const Layer* l : selected_)
+      prepared_.push_back(prepare(*l, exemplars.at(l->exemplar), maps));
     first_ = shot.source.first_frame;
   }
 
@@ -321,8 +313,15 @@ class ShotRun {
 
 RunReport run_shot(const Shot& shot, const FrameSource& frames,
                    const std::map<std::string, ExemplarImages>& exemplars,
-                   const CompositeInputs& ci, Store& store, const RunOptions& o) {
-  return ShotRun(shot, frames, exemplars, ci, store, o).run();
+                   const CompositeInputs& ci, Store& store, const RunOptions& o,
+                   const WeightMapImages& weight_maps) {
+  return ShotRun(shot, frames, exemplars, ci, store, o, weight_maps).run();
+}
+
+Image<float> synthesize_alone(const Layer& layer, const ExemplarImages& exemplar,
+                              ImageView<const float> passes, int frame,
+                              const WeightMapImages& weight_maps) {
+  return synthesize_layer(prepare(layer, exemplar, weight_maps), passes, frame, nullptr, nullptr);
 }
 
 int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInputs& ci,

@@ -68,14 +68,23 @@ struct CompositeInputs {
   Image<float> paper;  // empty: flat paper colour
 };
 
+// Painted guide weight maps (GuideSpec::map_image) by path: one channel each, the shot's size.
+using WeightMapImages = std::map<std::string, Image<float>>;
+
 // Runs (or resumes) the shot over the requested frames and layers. `exemplars` maps exemplar
-// names to their images. Throws emaki::Error for what a user can fix (a size that does not
-// match; an unknown layer in options.layers or a range outside the shot, named by the fields
-// "layers" and "frames").
+// names to their images; `weight_maps` holds every painted weight map the layers name. Throws
+// emaki::Error for what a user can fix (a size that does not match; an unknown layer in
+// options.layers or a range outside the shot, named by the fields "layers" and "frames").
 RunReport run_shot(const Shot& shot, const FrameSource& frames,
                    const std::map<std::string, ExemplarImages>& exemplars,
-                   const CompositeInputs& composite_inputs, Store& store,
-                   const RunOptions& options);
+                   const CompositeInputs& composite_inputs, Store& store, const RunOptions& options,
+                   const WeightMapImages& weight_maps = {});
+
+// `layer` at `frame` synthesized alone, without the temporal guide: what `temporal = false`
+// gives (the frame-by-frame reference of `emaki qa ghost`).
+Image<float> synthesize_alone(const Layer& layer, const ExemplarImages& exemplar,
+                              ImageView<const float> passes, int frame,
+                              const WeightMapImages& weight_maps = {});
 
 // Throws what run_shot would throw for `options` alone (fields "layers" and "frames"), so that a
 // front end can refuse a request before it creates an output file.

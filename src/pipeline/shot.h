@@ -11,6 +11,7 @@
 #include "exemplar/reference_sphere.h"
 #include "render/renderer.h"
 #include "scene/shot.h"
+#include "temporal/confidence.h"
 
 namespace emaki::pipeline {
 
@@ -68,6 +69,10 @@ struct Exemplar {
 struct GuideSpec {
   std::string pass;  // a pass name of passes.h
   float weight = 1.0f;
+  // Optional per-pixel weight over the frame, multiplying `weight`: a pass of each frame (its
+  // first channel) or a painted image (the shot's size, its first channel); at most one.
+  std::string map_pass = {};
+  std::string map_image = {};  // a path
 };
 
 // Where a layer is synthesized; the rest of the frame stays empty (transparent).
@@ -95,6 +100,10 @@ struct TemporalSpec {
   bool enabled = true;
   float weight = 1.0f;  // weight of the temporal guide pair in the main transfer
   AdvectionGuide guide = AdvectionGuide::kRestPosition;
+  // The advection's confidence as the temporal guide's weight map: none where the surface was
+  // hidden at t-1 (temporal/confidence.h). Off: full weight everywhere, as before it existed.
+  bool confidence = true;
+  temporal::ConfidenceParams confidence_params;  // not in the shot file: measured defaults
 };
 
 struct SynthSpec {

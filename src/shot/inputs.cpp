@@ -133,6 +133,21 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
   return out;
 }
 
+pipeline::WeightMapImages load_weight_maps(const Shot& shot) {
+  pipeline::WeightMapImages out;
+  for (const pipeline::Layer& l : shot.layers)
+    for (const pipeline::GuideSpec& g : l.guides) {
+      if (g.map_image.empty() || out.count(g.map_image)) continue;
+      const std::string key = fmt::format("layers.{}.guides.{}.map", l.name, g.pass);
+      const Image<float> img = io::read_image_float(g.map_image);
+      if (img.width() != shot.source.width || img.height() != shot.source.height)
+        throw Error(key, fmt::format("'{}' is {}x{}, the shot is {}x{}", g.map_image, img.width(),
+                                     img.height(), shot.source.width, shot.source.height));
+      out.emplace(g.map_image, pipeline::extract(img.cview(), 0, 1));
+    }
+  return out;
+}
+
 pipeline::CompositeInputs load_composite_inputs(const Shot& shot) {
   pipeline::CompositeInputs ci;
   if (!shot.compositing.paper.empty())

@@ -20,4 +20,8 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const pipeline::S
 
 pipeline::CompositeInputs load_composite_inputs(const pipeline::Shot& shot);
 
+// Every painted guide weight map the layers name (first channel); errors name
+// layers.NAME.guides.PASS.map (a map that is not the shot's size).
+pipeline::WeightMapImages load_weight_maps(const pipeline::Shot& shot);
+
 }  // namespace emaki::shot

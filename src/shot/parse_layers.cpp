@@ -54,9 +54,29 @@ void check_exemplar_exists(const Reader& r, const pipeline::Shot& shot, const st
                                : fmt::format(" — did you mean '{}'?", near)));
 }
 
+// layers.NAME.guides.PASS.map: a pass of each frame whose values are weights in [0, 1], or a
+// painted image (a path, resolved against the shot file's folder).
+void parse_weight_map(const Reader& r, const PathContext& ctx, pipeline::GuideSpec& g) {
+  const std::string map = r.string("map", "");
+  if (map.empty()) throw Error(r.key_path("map"), "must name a pass or an image");
+  for (const char* pass : {"diffuse", "shadow", "outline", "alpha"})
+    if (map == pass) {
+      g.map_pass = map;
+      return;
+    }
+  const std::vector<std::string> passes = pass_names();
+  if (std::find(passes.begin(), passes.end(), map) != passes.end())
+    throw Error(r.key_path("map"),
+                fmt::format("the '{}' pass does not hold weights in [0, 1]; use diffuse, shadow, "
+                            "outline or alpha, or a painted image",
+                            map));
+  g.map_image = ctx.input_file(r, "map", true);
+}
+
 // layers.NAME.guides: the passes in the file's order, so that results do not depend on how
-// toml++ sorts keys.
-std::vector<pipeline::GuideSpec> parse_guides(const Reader& r, const toml::table& t) {
+// toml++ sorts keys. A pass's value is its weight, or a table with its weight and weight map.
+std::vector<pipeline::GuideSpec> parse_guides(const Reader& r, const PathContext& ctx,
+                                              const toml::table& t) {
   const Reader g(t, r.key_path("guides"), "layers.NAME.guides", pass_names(), "PASS");
   // (line, column) as int64, since a 1 MB file may hold a million lines.
   std::vector<std::pair<std::string, int64_t>> order;
@@ -71,7 +91,14 @@ std::vector<pipeline::GuideSpec> parse_guides(const Reader& r, const toml::table
       throw Error(g.key_path(pass),
                   "this pass does not mean the same on the exemplar and the shot; "
                   "use normal, diffuse, shadow, outline, albedo, ...");
-    guides.push_back({pass, g.real(pass, 1.0f)});
+    if (const toml::table* sub = g.node(pass)->as_table()) {
+      const Reader m(*sub, g.key_path(pass), "layers.NAME.guides.PASS");
+      pipeline::GuideSpec spec{pass, m.real("weight", 1.0f)};
+      if (m.has("map")) parse_weight_map(m, ctx, spec);
+      guides.push_back(spec);
+    } else {
+      guides.push_back({pass, g.real(pass, 1.0f)});
+    }
   }
   if (guides.empty()) throw Error(r.key_path("guides"), "needs at least one pass");
   return guides;
@@ -174,7 +201,8 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
     throw Error(r.key_path("exemplar"), "is required (an [exemplars.NAME] table)");
   check_exemplar_exists(r, shot, l.exemplar);
   l.guides = d.guides;
-  if (const toml::table* t = r.table("guides")) l.guides = parse_guides(r, *t);
+  const PathContext ctx{std::filesystem::path(shot.path).parent_path()};
+  if (const toml::table* t = r.table("guides")) l.guides = parse_guides(r, ctx, *t);
   if (l.guides.empty()) throw Error(r.key_path("guides"), "is required for a 'custom' layer");
   parse_synthesis(r, l.synth);
   l.single_colour = r.boolean("single_colour", true);
@@ -183,6 +211,7 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   l.temporal.weight = r.real("temporal_weight", d.temporal_weight);
   l.temporal.guide =
       r.choice("advection", pipeline::AdvectionGuide::kRestPosition, kAdvectionGuides);
+  l.temporal.confidence = r.boolean("temporal_confidence", l.temporal.confidence);
   l.mask = d.mask;
   l.mask.kind = r.choice("mask", d.mask.kind, kMaskKinds);
   l.mask.dilate = r.real("mask_dilate", l.mask.dilate);

@@ -48,9 +48,10 @@ RunResult run(const pipeline::Shot& shot, const Request& request) {
   const auto frames = open_frames(shot);
   const auto exemplars = load_exemplars(shot);
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);
+  const pipeline::WeightMapImages maps = load_weight_maps(shot);
   RunResult out;
   io::FileStore store(shot, io::StoreMode::kRun, access(request));  // locked until the end
-  out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request));
+  out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request), maps);
   out.previews = previews(shot, request);
   return out;
 }
@@ -73,6 +74,7 @@ void prepare(const pipeline::Shot& shot) {
   (void)open_frames(shot);
   (void)load_exemplars(shot);
   (void)load_composite_inputs(shot);
+  (void)load_weight_maps(shot);
   io::FileStore store(shot);
   store.prepare();
 }

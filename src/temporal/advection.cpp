@@ -7,7 +7,7 @@
 
 namespace emaki::temporal {
 
-Image<float> advect(const AdvectionInputs& in, const synth::Params& params) {
+Advection advect(const AdvectionInputs& in, const synth::Params& params) {
   const ImageView<const float> prev = in.previous_stylized;
   CHECK(!prev.empty());
   const int n = in.value_channels;
@@ -43,14 +43,26 @@ Image<float> advect(const AdvectionInputs& in, const synth::Params& params) {
   p.search_radius = in.search_radius > 0
                         ? in.search_radius
                         : std::max(8, int(std::lround(std::max(prev.width, prev.height) / 60.0)));
-  synth::Result r = synth::synthesize(inputs, p);
-  if (r.image.channels() == n) return std::move(r.image);
+  synth::OutputRequest request;
+  request.nnf = request.error = in.surfaces.has_value();
+  synth::Result r = synth::synthesize(inputs, p, request);
+  Advection out;
+  if (in.surfaces) {
+    out.visible = visible_before(*in.surfaces);
+    out.foreign = foreign_share(r.nnf, *in.surfaces, p.patch_size, p.patch_size / 2);
+    out.confidence = confidence(out.visible, out.foreign, r.error, p.patch_size, in.confidence);
+  }
+  if (r.image.channels() == n) {
+    out.value = std::move(r.image);
+    return out;
+  }
   // Drop the alpha the mask added; outside the mask the value is the empty value.
-  Image<float> out(r.image.width(), r.image.height(), n);
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x) {
+  out.value.reset(r.image.width(), r.image.height(), n);
+  for (int y = 0; y < out.value.height(); ++y)
+    for (int x = 0; x < out.value.width(); ++x) {
       const float a = r.image(x, y, n);
-      for (int c = 0; c < n; ++c) out(x, y, c) = a * r.image(x, y, c) + (1.0f - a) * in.empty_value;
+      for (int c = 0; c < n; ++c)
+        out.value(x, y, c) = a * r.image(x, y, c) + (1.0f - a) * in.empty_value;
     }
   return out;
 }

@@ -10,6 +10,7 @@
 
 #include "core/image.h"
 #include "synth/synthesizer.h"
+#include "temporal/confidence.h"
 
 namespace emaki::temporal {
 
@@ -28,9 +29,20 @@ struct AdvectionInputs {
   // random search (propagation carries matches further); 0: the larger frame side / 60 (16 at
   // 960x540, 32 at 1920x1080), at least 8.
   int search_radius = 0;
+  // With the surfaces of both frames, the advection also says where B'adv can be trusted.
+  std::optional<Surfaces> surfaces;
+  ConfidenceParams confidence;
 };
 
-// B'adv, the size of the current frame, `value_channels` channels. `params` are the layer's
+struct Advection {
+  Image<float> value;  // B'adv, the size of the current frame, `value_channels` channels
+  // With surfaces (else empty): the confidence in [0, 1] and the evidence it was made from.
+  Image<float> confidence;
+  Image<uint8_t> visible;  // visible_before()
+  Image<float> foreign;    // foreign_share() of the advection's field
+};
+
+// B'adv (and, with surfaces, its confidence). `params` are the layer's
 // synthesis settings (patch size, seed — which should differ from the main transfer's); the
 // uniformity term is turned off, because an advection is a warp: spreading the use of
 // B'(t-1)'s patches evenly would pull them off the motion; for the same reason patches are
@@ -40,6 +52,6 @@ struct AdvectionInputs {
 // `search_radius`, refines it. Measured on the example against the main transfer's multiscale
 // schedule with a style weight of 1 against the guide's 1000: less flicker and a third of the
 // advection's time (docs/temporal.md).
-Image<float> advect(const AdvectionInputs& in, const synth::Params& params);
+Advection advect(const AdvectionInputs& in, const synth::Params& params);
 
 }  // namespace emaki::temporal

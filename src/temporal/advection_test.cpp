@@ -46,7 +46,7 @@ TEST(Advection, CarriesThePreviousFrameAlongThePositionGuide) {
   in.current_guide = g_cur.cview();
   synth::Params p;
   p.patch_size = 5;
-  const Image<float> adv = advect(in, p);
+  const Image<float> adv = advect(in, p).value;
   ASSERT_EQ(adv.channels(), 1);
   const Image<float> expected = stripes(w, h, 4.0f);
   const double moved = mean_abs_diff(adv, expected, 6);
@@ -65,7 +65,7 @@ TEST(Advection, FindsMotionWithinTheSearchRadius) {
   in.previous_guide = g_prev.cview();
   in.current_guide = g_cur.cview();
   in.search_radius = 16;
-  const Image<float> adv = advect(in, synth::Params{});
+  const Image<float> adv = advect(in, synth::Params{}).value;
   const Image<float> expected = stripes(w, h, 12.0f);
   // Where the moved content exists in the previous frame (x + 12 < w), it is carried exactly.
   double s = 0;
@@ -87,7 +87,7 @@ TEST(Advection, MaskedPreviousFrameUsesTheEmptyValue) {
   in.previous_guide = g.cview();
   in.current_guide = g.cview();
   in.empty_value = 0.9f;
-  const Image<float> adv = advect(in, synth::Params{});
+  const Image<float> adv = advect(in, synth::Params{}).value;
   EXPECT_NEAR(adv(w / 2, h / 2), 0.9f, 1e-4f);
 }
 

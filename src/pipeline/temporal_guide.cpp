@@ -1,0 +1,52 @@
+#include "pipeline/temporal_guide.h"
+
+#include "core/rng.h"
+#include "pipeline/frames.h"
+#include "render/passes.h"
+
+namespace emaki::pipeline {
+
+synth::Params synth_params(const SynthSpec& s, uint64_t seed) {
+  synth::Params p;
+  p.patch_size = s.patch_size;
+  p.uniformity = s.uniformity;
+  p.pyramid_levels = s.pyramid_levels;
+  p.search_vote_iters = s.search_vote_iters;
+  p.patch_match_iters = s.patch_match_iters;
+  p.seed = seed;
+  return p;
+}
+
+uint64_t frame_seed(const Layer& l, int frame, int transfer) {
+  return hash_key(l.synth.seed, uint64_t(frame), uint64_t(transfer));
+}
+
+temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
+                                 const Image<float>& mask, ImageView<const float> previous,
+                                 ImageView<const float> previous_passes, int frame) {
+  const Image<float> guide_prev = advection_guide(previous_passes, l.temporal.guide);
+  const Image<float> guide_cur = advection_guide(passes, l.temporal.guide);
+  temporal::AdvectionInputs a;
+  a.previous_stylized = previous;
+  a.value_channels = l.single_colour ? 1 : 3;
+  a.previous_guide = guide_prev.cview();
+  a.current_guide = guide_cur.cview();
+  a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
+  if (!mask.empty()) a.current_mask = mask.cview();
+  // The confidence's evidence: the surfaces (rest position + object id) whatever the guide.
+  Image<float> surf_prev, surf_cur, motion;
+  if (l.temporal.confidence) {
+    const bool rest = l.temporal.guide == AdvectionGuide::kRestPosition;
+    if (!rest) {
+      surf_prev = advection_guide(previous_passes, AdvectionGuide::kRestPosition);
+      surf_cur = advection_guide(passes, AdvectionGuide::kRestPosition);
+    }
+    motion = extract(passes, render::kMotion, 2);
+    a.surfaces = temporal::Surfaces{rest ? guide_prev.cview() : surf_prev.cview(),
+                                    rest ? guide_cur.cview() : surf_cur.cview(), motion.cview()};
+    a.confidence = l.temporal.confidence_params;
+  }
+  return temporal::advect(a, synth_params(l.synth, frame_seed(l, frame, 1)));
+}
+
+}  // namespace emaki::pipeline

@@ -1,0 +1,192 @@
+#include "temporal/confidence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/check.h"
+#include "core/parallel.h"
+
+namespace emaki::temporal {
+
+namespace {
+
+float rest_distance(const float* a, const float* b) {
+  const float dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// The largest rest-position step from (x, y) to a 4-neighbour showing the same object at t: how
+// much rest space one pixel spans there.
+float footprint(ImageView<const float> cur, int x, int y) {
+  const float* p = cur.at(x, y);
+  float f = 0.0f;
+  const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+  for (int k = 0; k < 4; ++k) {
+    const int nx = x + dx[k], ny = y + dy[k];
+    if (nx < 0 || ny < 0 || nx >= cur.width || ny >= cur.height) continue;
+    const float* q = cur.at(nx, ny);
+    if (q[3] == p[3]) f = std::max(f, rest_distance(p, q));
+  }
+  return f;
+}
+
+}  // namespace
+
+Image<uint8_t> visible_before(const Surfaces& s, float tolerance) {
+  const ImageView<const float> prev = s.previous, cur = s.current, motion = s.motion;
+  CHECK_EQ(prev.width, cur.width);
+  CHECK_EQ(prev.height, cur.height);
+  CHECK_EQ(motion.width, cur.width);
+  CHECK_GE(cur.channels, 4);
+  const int w = cur.width, h = cur.height;
+  Image<uint8_t> out(w, h, 1);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float* p = cur.at(x, y);
+        const float sx = x + motion(x, y, 0), sy = y + motion(x, y, 1);
+        const int x0 = int(std::floor(sx)), y0s = int(std::floor(sy));
+        // The pixels the bilinear sample at (sx, sy) reads: one to four.
+        const int ni = sx > float(x0) ? 2 : 1, nj = sy > float(y0s) ? 2 : 1;
+        // A pixel with no neighbour of its object has no footprint: a tiny one keeps exact
+        // matches.
+        const float tol = tolerance * std::max(footprint(cur, x, y), 1e-6f);
+        bool seen = false;
+        for (int j = 0; j < nj && !seen; ++j)
+          for (int i = 0; i < ni && !seen; ++i) {
+            const int qx = x0 + i, qy = y0s + j;
+            if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+            const float* q = prev.at(qx, qy);
+            seen = q[3] == p[3] && rest_distance(p, q) <= tol;
+          }
+        out(x, y) = seen ? 1 : 0;
+      }
+  });
+  return out;
+}
+
+namespace {
+
+// For each id k present in `ids` (channel 3), the share of the pixels within `radius` of each
+// pixel (clamped window) that show k: one box-filtered indicator per id.
+struct IdShares {
+  std::vector<float> ids;
+  std::vector<Image<float>> share;  // parallel to ids
+  // The share of the window around (x, y) showing id k (0 for an id not present).
+  float of(float k, int x, int y) const {
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (ids[i] == k) return share[i](x, y);
+    return 0.0f;
+  }
+};
+
+Image<float> box_share(ImageView<const float> ids, float k, int radius) {
+  const int w = ids.width, h = ids.height;
+  Image<float> rows(w, h, 1), out(w, h, 1);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        int n = 0, hit = 0;
+        for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
+          ++n, hit += ids(u, y, 3) == k ? 1 : 0;
+        rows(x, y) = float(hit) / float(n);
+      }
+  });
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        float sum = 0.0f;
+        int n = 0;
+        for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v)
+          ++n, sum += rows(x, v);
+        out(x, y) = sum / float(n);
+      }
+  });
+  return out;
+}
+
+IdShares id_shares(ImageView<const float> ids, int radius) {
+  IdShares s;
+  for (int y = 0; y < ids.height; ++y)
+    for (int x = 0; x < ids.width; ++x) {
+      const float k = ids(x, y, 3);
+      if (std::find(s.ids.begin(), s.ids.end(), k) == s.ids.end()) s.ids.push_back(k);
+    }
+  for (float k : s.ids) s.share.push_back(box_share(ids, k, radius));
+  return s;
+}
+
+}  // namespace
+
+Image<float> foreign_share(const Image<int32_t>& nnf, const Surfaces& s, int patch_size,
+                           int footprint) {
+  const ImageView<const float> prev = s.previous, cur = s.current;
+  const int w = nnf.width(), h = nnf.height(), r = patch_size / 2;
+  CHECK_EQ(cur.width, w);
+  CHECK_EQ(cur.height, h);
+  const IdShares shares = id_shares(prev, footprint);
+  Image<float> out(w, h, 1);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float id = cur(x, y, 3);
+        int votes = 0;
+        float foreign = 0.0f;
+        for (int uy = std::max(0, y - r); uy <= std::min(h - 1, y + r); ++uy)
+          for (int ux = std::max(0, x - r); ux <= std::min(w - 1, x + r); ++ux) {
+            const int32_t* m = nnf.at(ux, uy);
+            if (m[0] < 0) continue;
+            const int qx = m[0] + (x - ux), qy = m[1] + (y - uy);
+            if (qx < 0 || qy < 0 || qx >= prev.width || qy >= prev.height) continue;
+            ++votes;
+            foreign += 1.0f - shares.of(id, qx, qy);
+          }
+        out(x, y) = votes ? foreign / float(votes) : 0.0f;
+      }
+  });
+  return out;
+}
+
+Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& foreign,
+                        const Image<float>& error, int patch_size, const ConfidenceParams& cp) {
+  const int w = visible.width(), h = visible.height();
+  CHECK_EQ(foreign.width(), w);
+  CHECK_EQ(error.width(), w);
+  CHECK_LT(cp.error_full, cp.error_none);
+  const double norm = 1.0 / (65025.0 * patch_size * patch_size);
+  Image<float> c(w, h, 1);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float rms = float(std::sqrt(std::max(0.0, double(error(x, y)) * norm)));
+        const float ramp =
+            std::clamp((cp.error_none - rms) / (cp.error_none - cp.error_full), 0.0f, 1.0f);
+        c(x, y) = visible(x, y) ? (1.0f - foreign(x, y)) * ramp : 0.0f;
+      }
+  });
+  if (cp.erode <= 0) return c;
+  // Min filter, separable: rows then columns.
+  Image<float> rows(w, h, 1), out(w, h, 1);
+  const int e = cp.erode;
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        float m = 1.0f;
+        for (int k = std::max(0, x - e); k <= std::min(w - 1, x + e); ++k) m = std::min(m, c(k, y));
+        rows(x, y) = m;
+      }
+  });
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        float m = 1.0f;
+        for (int k = std::max(0, y - e); k <= std::min(h - 1, y + e); ++k)
+          m = std::min(m, rows(x, k));
+        out(x, y) = m;
+      }
+  });
+  return out;
+}
+
+}  // namespace emaki::temporal

@@ -1,0 +1,56 @@
+// Where the advected previous frame can guide the current one. B'adv is B'(t-1) carried along
+// the advection's field; at a pixel whose surface point was hidden at t-1 (ground uncovered by
+// a swinging tail, a limb passing in front) there is nothing right to carry, and B'adv holds
+// the touch of whatever covered it. The confidence is 1 where the advection's own evidence says
+// the surface was visible and carried from itself, 0 where it was not, and the main transfer
+// uses it as the temporal guide's weight map.
+#pragma once
+
+#include "core/image.h"
+
+namespace emaki::temporal {
+
+// The surface each pixel shows: rest-pose position (3 channels, any fixed space) and object id
+// (1 channel, integers; 0: nothing) — of frames t-1 and t — and the motion from t to t-1.
+struct Surfaces {
+  ImageView<const float> previous;  // frame t-1, 4 channels
+  ImageView<const float> current;   // frame t, 4 channels
+  ImageView<const float> motion;  // frame t, 2 channels: pixels from here to the same point at t-1
+};
+
+// 1 where the surface point a pixel of frame t shows was visible at t-1: one of the (up to
+// four) pixels a bilinear sample where its motion leads in t-1 reads shows the same object with a
+// rest position within `tolerance` pixel footprints of it (the largest rest-position step to a
+// neighbour of the same object at t). 0 where it was hidden or outside the frame. This is `emaki qa
+// flicker`'s occlusion test (same object around the motion's end) with the rest position added, so
+// that a limb passing in front of its own body counts as a cover too.
+Image<uint8_t> visible_before(const Surfaces& s, float tolerance = 3.0f);
+
+// For each pixel of frame t, the share of its B'adv value that came from another object than
+// the one it shows. B'adv at a pixel is the vote of the patches over it, each matched to a patch
+// of t-1 by `nnf` (patch centres in t-1, -1 outside its mask: not counted), so it reads one
+// pixel of t-1 per patch; and B'(t-1) at that pixel was itself the vote of the patches of t-1's
+// synthesis within `footprint` pixels of it (the patch radius), each centred on some object.
+// A vote counts the share of those centres on another object: a value carried from next to
+// another object's silhouette carries that object's bleed. Pixels no patch votes are 0.
+Image<float> foreign_share(const Image<int32_t>& nnf, const Surfaces& s, int patch_size,
+                           int footprint);
+
+// How the evidence becomes a confidence (defaults measured on the example, docs/temporal.md).
+struct ConfidenceParams {
+  // The advection's patch error as an RMS guide difference per channel (guide values in [0, 1]):
+  // full confidence up to error_full, none from error_none, linear between.
+  float error_full = 0.02f;
+  float error_none = 0.08f;
+  // Shrink the confident region by this many pixels (a patch centred there then sees no
+  // untrusted pixel); 0: none.
+  int erode = 0;
+};
+
+// visible x (1 - foreign) x the error ramp, eroded. `error`: the advection's per-pixel patch
+// error in EbSynth units (synth::Result::error) over guides whose weights sum to 1, which makes
+// sqrt(error / (65025 x patch_size^2)) the RMS guide difference; `patch_size` the advection's.
+Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& foreign,
+                        const Image<float>& error, int patch_size, const ConfidenceParams& params);
+
+}  // namespace emaki::temporal
