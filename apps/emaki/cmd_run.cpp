@@ -1,6 +1,7 @@
 // `emaki run SHOT`: a whole shot — every layer of every frame, the temporal chain, compositing,
 // previews — resuming after the last finished frame. `emaki composite SHOT` re-colours finished
-// layers without synthesizing. `emaki qa flicker SHOT --layer NAME` measures temporal error.
+// layers without synthesizing. `emaki qa flicker|ghost SHOT --layer NAME` measures temporal
+// error and ghosts.
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -58,9 +59,9 @@ int run_composite(const Args& args) {
   return 0;
 }
 
-int run_qa(const Args& args) {
-  if (args.empty() || args[0] != "flicker")
-    throw Error("", "usage: emaki qa flicker SHOT --layer NAME [--frames A-B]");
+namespace {
+
+int run_qa_flicker(const Args& args) {
   CLI::App app{
       "Temporal error of a layer's frames: mean |B'(t) - B'(t-1)| sampled along the "
       "renderer's motion vectors over pixels visible in both frames, split into scene "
@@ -70,7 +71,7 @@ int run_qa(const Args& args) {
   std::string layer;
   c.bind(app, "FIRST-LAST (default: all)");
   app.add_option("--layer", layer, "the layer to measure")->required();
-  if (parse_cli(app, Args(args.begin() + 1, args.end()))) return 0;
+  if (parse_cli(app, args)) return 0;
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request request = c.request("qa");
   request.progress = nullptr;
@@ -87,6 +88,48 @@ int run_qa(const Args& args) {
       "\"ground\": %.6f}\n",
       layer.c_str(), r.first_frame, r.last_frame, m.all.mean(), m.objects.mean(), m.ground.mean());
   return 0;
+}
+
+int run_qa_ghost(const Args& args) {
+  CLI::App app{
+      "Ghosts of a temporal layer: over pixels whose surface was hidden at t-1 (motion, "
+      "object id and rest position), the share of the temporal guide's pull that came from "
+      "another object, and the mean |temporal - frame-by-frame| there (the frame-by-frame "
+      "results are synthesized, about one synthesis per frame). Prints a table and a JSON "
+      "line.",
+      "emaki qa ghost"};
+  ShotCommand c;
+  std::string layer;
+  c.bind(app, "FIRST-LAST (default: all)");
+  app.add_option("--layer", layer, "the layer to measure")->required();
+  if (parse_cli(app, args)) return 0;
+  const pipeline::Shot shot = shot::open(c.shot_path);
+  shot::Request request = c.request("qa");
+  request.progress = nullptr;
+  const shot::GhostResult r = shot::ghost(shot, layer, request);
+  std::printf("%-6s %9s %12s %12s %14s\n", "frame", "hidden", "ghost share", "diff hidden",
+              "diff visible");
+  for (const pipeline::FrameGhost& f : r.frames)
+    std::printf("%-6d %9ld %12.4f %12.5f %14.5f\n", f.frame, f.stats.hidden, f.stats.ghost_share(),
+                f.stats.diff(), f.stats.visible_diff());
+  const pipeline::GhostStats& t = r.total;
+  std::printf("%-6s %9ld %12.4f %12.5f %14.5f\n", "all", t.hidden, t.ghost_share(), t.diff(),
+              t.visible_diff());
+  std::printf(
+      "{\"layer\": \"%s\", \"frames\": [%d, %d], \"hidden_pixels\": %ld, "
+      "\"ghost_share\": %.6f, \"diff_hidden\": %.6f, \"diff_visible\": %.6f}\n",
+      layer.c_str(), r.first_frame, r.last_frame, t.hidden, t.ghost_share(), t.diff(),
+      t.visible_diff());
+  return 0;
+}
+
+}  // namespace
+
+int run_qa(const Args& args) {
+  const std::string usage = "usage: emaki qa flicker|ghost SHOT --layer NAME [--frames A-B]";
+  if (args.empty() || (args[0] != "flicker" && args[0] != "ghost")) throw Error("", usage);
+  const Args rest(args.begin() + 1, args.end());
+  return args[0] == "flicker" ? run_qa_flicker(rest) : run_qa_ghost(rest);
 }
 
 }  // namespace emaki::app

@@ -22,7 +22,7 @@ const std::vector<Command>& commands() {
       {"run", "a whole shot from its shot file: layers, temporal chain, compositing, previews",
        run_run},
       {"composite", "re-colour a shot's finished layers without synthesizing again", run_composite},
-      {"qa", "quality checks: 'emaki qa flicker SHOT --layer NAME'", run_qa},
+      {"qa", "quality checks: 'emaki qa flicker|ghost SHOT --layer NAME'", run_qa},
       {"plan", "shots as a task graph for a render farm (a table, or --json)", run_plan},
       {"farm", "run shots on Slurm: 'emaki farm submit|status|cancel SHOT...'", run_farm},
       {"task", "one task of a plan, as a farm node runs it", run_task},

@@ -101,25 +101,49 @@ std::vector<std::string> write_previews(const pipeline::Shot& shot, const Reques
   return io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
 }
 
+// The layer and frame range a measure over finished frames (qa flicker, qa ghost) reads.
+const pipeline::Layer& measured_range(const pipeline::Shot& shot, const std::string& layer,
+                                      const Request& request, int& first, int& last) {
+  const pipeline::Layer* l = shot.find_layer(layer);
+  if (!l) throw Error(Error::Field{"layer"}, fmt::format("no layer '{}' in the shot", echo(layer)));
+  first = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
+  last = request.last_frame < 0 ? shot.source.last_frame : request.last_frame;
+  if (last <= first) throw Error(Error::Field{"frames"}, "needs at least two frames");
+  if (first < shot.source.first_frame || last > shot.source.last_frame)
+    throw Error(Error::Field{"frames"},
+                fmt::format("{}-{} is outside the shot's frames {}-{}", first, last,
+                            shot.source.first_frame, shot.source.last_frame));
+  return *l;
+}
+
 FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,
                       const Request& request) {
   use_threads(shot, request);
-  const pipeline::Layer* l = shot.find_layer(layer);
-  if (!l) throw Error(Error::Field{"layer"}, fmt::format("no layer '{}' in the shot", echo(layer)));
   FlickerResult out;
-  out.first_frame = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
-  out.last_frame = request.last_frame < 0 ? shot.source.last_frame : request.last_frame;
-  if (out.last_frame <= out.first_frame)
-    throw Error(Error::Field{"frames"}, "needs at least two frames");
-  if (out.first_frame < shot.source.first_frame || out.last_frame > shot.source.last_frame)
-    throw Error(Error::Field{"frames"},
-                fmt::format("{}-{} is outside the shot's frames {}-{}", out.first_frame,
-                            out.last_frame, shot.source.first_frame, shot.source.last_frame));
+  const pipeline::Layer* l = &measured_range(shot, layer, request, out.first_frame, out.last_frame);
   const auto frames = open_frames(shot);
   io::FileStore store(shot, io::StoreMode::kReadFinished);
   out.mean =
       pipeline::measure_flicker(*l, *frames, store, out.first_frame, out.last_frame,
                                 [&](const pipeline::FrameFlicker& f) { out.frames.push_back(f); });
+  return out;
+}
+
+GhostResult ghost(const pipeline::Shot& shot, const std::string& layer, const Request& request) {
+  use_threads(shot, request);
+  GhostResult out;
+  const pipeline::Layer& l = measured_range(shot, layer, request, out.first_frame, out.last_frame);
+  const auto frames = open_frames(shot);
+  const auto exemplars = load_exemplars(shot);
+  const pipeline::WeightMapImages maps = load_weight_maps(shot);
+  io::FileStore store(shot, io::StoreMode::kReadFinished);
+  const auto reference = [&](int f) {
+    return pipeline::synthesize_alone(l, exemplars.at(l.exemplar), frames->passes(f).cview(), f,
+                                      maps);
+  };
+  out.total =
+      pipeline::measure_ghost(l, *frames, store, out.first_frame, out.last_frame, reference,
+                              [&](const pipeline::FrameGhost& f) { out.frames.push_back(f); });
   return out;
 }
 

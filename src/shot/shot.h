@@ -1,7 +1,7 @@
 // The shot API: the one surface every front end (the CLI, the farm submitter, the Python module)
-// drives. open() reads and checks a shot file; run(), composite() and flicker() open its inputs,
-// lock its output folder and do the work. Errors are emaki::Error: a shot file's problems name
-// its key ("layers.outline.mask"); a Request's name neutral fields ("frames", "layers",
+// drives. open() reads and checks a shot file; run(), composite(), flicker() and ghost() open its
+// inputs, lock its output folder and do the work. Errors are emaki::Error: a shot file's problems
+// name its key ("layers.outline.mask"); a Request's name neutral fields ("frames", "layers",
 // "layer", "threads") that each front end spells its own way (--frames, frames=).
 #pragma once
 
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pipeline/flicker.h"
+#include "pipeline/ghost.h"
 #include "pipeline/run.h"
 #include "pipeline/shot.h"
 
@@ -71,5 +72,16 @@ struct FlickerResult {
 
 // The temporal error of a finished layer (field "layer" names it) over at least two frames.
 FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer, const Request& request);
+
+struct GhostResult {
+  int first_frame = 0, last_frame = 0;
+  std::vector<pipeline::FrameGhost> frames;  // first_frame + 1 .. last_frame
+  pipeline::GhostStats total;                // pooled over the frames' pixels
+};
+
+// Ghosts of a finished temporal layer (field "layer" names it) over at least two frames
+// (pipeline/ghost.h): its frames against frame-by-frame results synthesized here (the same
+// seeds a `temporal = false` run draws), which takes about one synthesis per frame.
+GhostResult ghost(const pipeline::Shot& shot, const std::string& layer, const Request& request);
 
 }  // namespace emaki::shot
