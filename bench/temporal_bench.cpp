@@ -1,24 +1,31 @@
 // Temporal noise reduction on the bundled example (examples/fox/shot.toml): one layer run
-// frame by frame, with advection by `position` (the paper's) and by `rest_position`, compared
-// on flicker (`emaki qa flicker`'s measure, split into the walking Fox and the static ground)
-// and, with --judge, on the independent judge's `style` energy of sampled frames (is the
-// output still made of exemplar texture?). Frames stay in memory; nothing is written except
-// the judge's inputs.
+// frame by frame and with advection by `position` (the paper's) or `rest_position`, each with or
+// without the advection's confidence as the temporal guide's weight map, compared on flicker
+// (`emaki qa flicker`'s measure, split into the walking Fox and the static ground), on ghosts
+// (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with --judge, on the
+// independent judge's `style` energy of sampled frames (is the output still made of exemplar
+// texture?). Frames stay in memory; nothing is written except the judge's inputs and, with
+// --save, the variants' layer frames as PNGs.
 //
-//   temporal_bench [--size 960x540] [--frames 48] [--layer base] [--variants
-//   frame,position,rest_position]
-//                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--threads N]
+//   temporal_bench [--size 960x540] [--frames 48] [--layer base]
+//                  [--variants frame,rest_position_noconf,rest_position,...]
+//                  [--error-full X] [--error-none Y] [--erode N] [--temporal-weight W]
+//                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--save DIR]
+//                  [--threads N]
 //
-// The judge is ../shared/tools/judge (build it with its build.sh). Its guides are the layer's
-// guides (normal mapped to [0,1], diffuse) with the layer's weights; outside the layer's mask
-// the output is taken as white on every variant alike.
+// Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
+// `position`, `rest_position` (with confidence, the default), `position_noconf`,
+// `rest_position_noconf` (temporal_confidence = false). --error-* and --erode set the
+// confidence's parameters (temporal::ConfidenceParams). The judge is ../shared/tools/judge
+// (build it with its build.sh). Its guides are the layer's guides (normal mapped to [0,1],
+// diffuse) with the layer's weights; outside the layer's mask the output is taken as white on
+// every variant alike.
 #include <fmt/format.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -31,6 +38,7 @@
 #include "memory_store.h"
 #include "pipeline/flicker.h"
 #include "pipeline/frames.h"
+#include "pipeline/ghost.h"
 #include "pipeline/run.h"
 #include "render/passes.h"
 #include "shot/inputs.h"
@@ -40,19 +48,37 @@ namespace {
 
 using namespace emaki;
 
+const std::vector<std::string> kVariants = {"frame", "position", "rest_position", "position_noconf",
+                                            "rest_position_noconf"};
+
 struct Options {
   int width = 960, height = 540, frames = 48, threads = 0, judge_every = 8;
-  std::string layer = "base", judge, judge_dir = "/tmp/emaki_temporal_judge";
-  std::vector<std::string> variants = {"frame", "position", "rest_position"};
+  std::string layer = "base", judge, judge_dir = "/tmp/emaki_temporal_judge", save;
+  std::vector<std::string> variants = {"frame", "position", "rest_position_noconf",
+                                       "rest_position"};
+  temporal::ConfidenceParams confidence;
+  float temporal_weight = -1.0f;  // -1: the example's
 };
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "temporal_bench: %s\nusage: temporal_bench [--size WxH] [--frames N] [--layer NAME] "
-               "[--variants a,b,...] [--judge PATH] [--judge-every K] [--judge-dir DIR] "
-               "[--threads N]\n",
+               "[--variants a,b,...] [--error-full X] [--error-none Y] [--erode N] "
+               "[--temporal-weight W] [--judge PATH] "
+               "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",
                why.c_str());
   std::exit(2);
+}
+
+std::vector<std::string> parse_variants(const std::string& v) {
+  std::vector<std::string> out;
+  std::stringstream ss(v);
+  for (std::string s; std::getline(ss, s, ',');) {
+    if (std::find(kVariants.begin(), kVariants.end(), s) == kVariants.end())
+      usage("bad variant " + s);
+    out.push_back(s);
+  }
+  return out;
 }
 
 Options parse(int argc, char** argv) {
@@ -68,18 +94,23 @@ Options parse(int argc, char** argv) {
     } else if (a == "--layer") {
       o.layer = v;
     } else if (a == "--variants") {
-      o.variants.clear();
-      std::stringstream ss(v);
-      for (std::string s; std::getline(ss, s, ',');) {
-        if (s != "frame" && s != "position" && s != "rest_position") usage("bad variant " + s);
-        o.variants.push_back(s);
-      }
+      o.variants = parse_variants(v);
+    } else if (a == "--error-full") {
+      o.confidence.error_full = std::strtof(v.c_str(), nullptr);
+    } else if (a == "--error-none") {
+      o.confidence.error_none = std::strtof(v.c_str(), nullptr);
+    } else if (a == "--erode") {
+      o.confidence.erode = std::atoi(v.c_str());
+    } else if (a == "--temporal-weight") {
+      o.temporal_weight = std::strtof(v.c_str(), nullptr);
     } else if (a == "--judge") {
       o.judge = v;
     } else if (a == "--judge-every") {
       o.judge_every = std::max(1, std::atoi(v.c_str()));
     } else if (a == "--judge-dir") {
       o.judge_dir = v;
+    } else if (a == "--save") {
+      o.save = v;
     } else if (a == "--threads") {
       o.threads = std::atoi(v.c_str());
     } else {
@@ -119,120 +150,185 @@ double run_judge(const std::string& cmd) {
   return std::stod(m[1]);
 }
 
+// The layer's value over white outside its mask: what the judge and --save see.
+Image<float> on_white(const Image<float>& v, int value_channels) {
+  Image<float> out(v.width(), v.height(), value_channels);
+  for (int y = 0; y < v.height(); ++y)
+    for (int x = 0; x < v.width(); ++x) {
+      const float a = v.channels() > value_channels ? v(x, y, value_channels) : 1.0f;
+      for (int c = 0; c < value_channels; ++c) out(x, y, c) = a * v(x, y, c) + (1.0f - a);
+    }
+  return out;
+}
+
+// One variant: the layer's settings for it, its frames and what was measured on them.
+struct Variant {
+  std::string name;
+  pipeline::Layer layer;
+  bench::MemoryStore store;
+  double seconds = 0.0;
+  pipeline::SequenceFlicker flicker;
+  pipeline::GhostStats ghost;
+  double style_sum = 0.0;
+};
+
+pipeline::Layer variant_layer(pipeline::Layer l, const std::string& name, const Options& o) {
+  l.temporal.enabled = name != "frame";
+  l.temporal.guide = name.rfind("position", 0) == 0 ? pipeline::AdvectionGuide::kPosition
+                                                    : pipeline::AdvectionGuide::kRestPosition;
+  l.temporal.confidence = name.find("_noconf") == std::string::npos;
+  l.temporal.confidence_params = o.confidence;
+  if (o.temporal_weight >= 0.0f) l.temporal.weight = o.temporal_weight;
+  return l;
+}
+
+// The example at the bench's size and length, with `layer` found in it.
+pipeline::Shot example(const Options& opt, pipeline::Layer*& layer) {
+  pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
+  shot.source.width = shot.source.render.width = opt.width;
+  shot.source.height = shot.source.render.height = opt.height;
+  shot.source.last_frame = shot.source.first_frame + opt.frames - 1;
+  shot.source.shot.last_frame = shot.source.last_frame;
+  layer = nullptr;
+  for (pipeline::Layer& l : shot.layers)
+    if (l.name == opt.layer) layer = &l;
+  if (!layer) usage("no layer " + opt.layer + " in the example");
+  return shot;
+}
+
+// Each variant's frames, the layer alone (the shot's other layers are left out).
+void run_variants(pipeline::Shot& shot, pipeline::Layer& layer, const pipeline::FrameSource& src,
+                  std::vector<Variant>& variants, const Options& opt) {
+  const auto exemplars = shot::load_exemplars(shot);
+  const pipeline::CompositeInputs ci = shot::load_composite_inputs(shot);
+  const pipeline::Layer original = layer;
+  for (Variant& v : variants) {
+    layer = v.layer;
+    pipeline::RunOptions o;
+    o.layers = {opt.layer};
+    const auto t0 = std::chrono::steady_clock::now();
+    pipeline::run_shot(shot, src, exemplars, ci, v.store, o);
+    v.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::fprintf(stderr, "temporal_bench: %s done in %.1f s\n", v.name.c_str(), v.seconds);
+  }
+  layer = original;
+}
+
+// Judge inputs that do not change: the touch and the exemplar's guides. Returns the command's
+// fixed part.
+std::string judge_setup(const pipeline::Shot& shot, const pipeline::Layer& layer,
+                        const Options& opt) {
+  std::filesystem::create_directories(opt.judge_dir);
+  const pipeline::ExemplarImages ex = std::move(shot::load_exemplars(shot).at(layer.exemplar));
+  const std::string style = opt.judge_dir + "/style.png";
+  write_png(style, layer.single_colour ? composite::touch(ex.painting.cview(), layer.channel)
+                                       : pipeline::extract(ex.painting.cview(), 0, 3));
+  for (const pipeline::GuideSpec& g : layer.guides)
+    write_png(fmt::format("{}/source_{}.png", opt.judge_dir, g.pass),
+              judge_guide(pipeline::extract_pass(ex.passes.cview(), g.pass), g.pass));
+  return fmt::format("'{}' -style '{}'", opt.judge, style);
+}
+
+// The judge's style energy of every variant's frame f, added to its sum.
+void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const Image<float>& passes,
+                 int f, std::vector<Variant>& variants, const Options& opt) {
+  std::string guides;
+  for (const pipeline::GuideSpec& g : layer.guides) {
+    const std::string tgt = fmt::format("{}/target_{}_{:04d}.png", opt.judge_dir, g.pass, f);
+    write_png(tgt, judge_guide(pipeline::extract_pass(passes.cview(), g.pass), g.pass));
+    guides += fmt::format(" -guide '{}/source_{}.png' '{}' -weight {}", opt.judge_dir, g.pass, tgt,
+                          g.weight);
+  }
+  const int n = layer.single_colour ? 1 : 3;
+  for (Variant& v : variants) {
+    const std::string path = fmt::format("{}/{}_{:04d}.png", opt.judge_dir, v.name, f);
+    write_png(path, on_white(v.store.read_layer(layer, f), n));
+    const double s = run_judge(fixed + guides + fmt::format(" -output-to-judge '{}'", path));
+    std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f\n", f, v.name.c_str(), s);
+    v.style_sum += s;
+  }
+}
+
+// Flicker of frame f of variant v, its ghosts against the reference variant (frame by frame,
+// when it is the first one) and, with --save, the frame as a PNG.
+void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& layer,
+                   const Image<float>& passes, const Image<float>& prev_passes, int f,
+                   const Options& opt) {
+  const int n = layer.single_colour ? 1 : 3;
+  const Image<float> cur = v.store.read_layer(layer, f), prev = v.store.read_layer(layer, f - 1);
+  const int mask_channel = cur.channels() > n ? n : -1;
+  v.flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
+                                        prev_passes.cview(), mask_channel));
+  if (reference.name == "frame" && v.layer.temporal.enabled) {
+    const Image<float> ref = reference.store.read_layer(layer, f);
+    v.ghost.add(pipeline::frame_ghost(v.layer, cur.cview(), prev.cview(), ref.cview(),
+                                      passes.cview(), prev_passes.cview(), f)
+                    .stats);
+  }
+  if (!opt.save.empty())
+    write_png(fmt::format("{}/{}_{:04d}.png", opt.save, v.name, f), on_white(cur, n));
+}
+
+void print_table(const std::vector<Variant>& variants, const Options& opt, int first, int last,
+                 int judged) {
+  std::printf("temporal_bench: layer '%s', %dx%d, frames %d-%d, %d threads%s\n", opt.layer.c_str(),
+              opt.width, opt.height, first, last, thread_count(),
+              judged ? fmt::format(", judge on {} frames", judged).c_str() : "");
+  std::printf("%-21s %8s %9s %9s %9s %9s %12s %9s %9s %9s\n", "variant", "s/frame", "flicker",
+              "fox", "ground", "vs frame", "judge style", "ghost", "diff hid", "diff vis");
+  const Variant& base = variants[0];
+  const bool ref = base.name == "frame";
+  const double base_style = ref && judged ? base.style_sum / judged : 0.0;
+  for (const Variant& v : variants) {
+    const double style = judged ? v.style_sum / judged : 0.0;
+    const std::string style_text =
+        judged ? fmt::format("{:.6f}{}", style,
+                             base_style > 0
+                                 ? fmt::format(" ({:+.1f} %)", 100.0 * (style / base_style - 1))
+                                 : "")
+               : "-";
+    const bool ghosted = ref && v.layer.temporal.enabled;
+    std::printf("%-21s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s\n", v.name.c_str(),
+                v.seconds / opt.frames, v.flicker.all.mean(), v.flicker.objects.mean(),
+                v.flicker.ground.mean(), ref ? v.flicker.all.mean() / base.flicker.all.mean() : 0.0,
+                style_text.c_str(),
+                ghosted ? fmt::format("{:.4f}", v.ghost.ghost_share()).c_str() : "-",
+                ghosted ? fmt::format("{:.5f}", v.ghost.diff()).c_str() : "-",
+                ghosted ? fmt::format("{:.5f}", v.ghost.visible_diff()).c_str() : "-");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Options opt = parse(argc, argv);
   set_thread_count(opt.threads);
   try {
-    pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
-    shot.source.width = shot.source.render.width = opt.width;
-    shot.source.height = shot.source.render.height = opt.height;
-    shot.source.last_frame = shot.source.first_frame + opt.frames - 1;
-    shot.source.shot.last_frame = shot.source.last_frame;
     pipeline::Layer* layer = nullptr;
-    for (pipeline::Layer& l : shot.layers)
-      if (l.name == opt.layer) layer = &l;
-    if (!layer) usage("no layer " + opt.layer + " in the example");
+    pipeline::Shot shot = example(opt, layer);
     const auto source = shot::open_frames(shot);
-    const auto exemplars = shot::load_exemplars(shot);
-    const pipeline::CompositeInputs ci = shot::load_composite_inputs(shot);
     const int first = shot.source.first_frame, last = shot.source.last_frame;
-    const int value_channels = layer->single_colour ? 1 : 3;
-
-    std::vector<bench::MemoryStore> stores(opt.variants.size());
-    std::vector<double> seconds(opt.variants.size());
-    for (std::size_t v = 0; v < opt.variants.size(); ++v) {
-      const std::string& name = opt.variants[v];
-      layer->temporal.enabled = name != "frame";
-      layer->temporal.guide = name == "position" ? pipeline::AdvectionGuide::kPosition
-                                                 : pipeline::AdvectionGuide::kRestPosition;
-      pipeline::RunOptions o;
-      o.layers = {opt.layer};
-      const auto t0 = std::chrono::steady_clock::now();
-      pipeline::run_shot(shot, *source, exemplars, ci, stores[v], o);
-      seconds[v] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::fprintf(stderr, "temporal_bench: %s done in %.1f s\n", name.c_str(), seconds[v]);
-    }
-
-    // Judge inputs that do not change: the touch and the exemplar's guides.
+    std::vector<Variant> variants(opt.variants.size());
+    for (std::size_t i = 0; i < variants.size(); ++i)
+      variants[i].name = opt.variants[i],
+      variants[i].layer = variant_layer(*layer, opt.variants[i], opt);
+    run_variants(shot, *layer, *source, variants, opt);
     const bool judging = !opt.judge.empty();
-    std::string judge_fixed;
-    if (judging) {
-      std::filesystem::create_directories(opt.judge_dir);
-      const pipeline::ExemplarImages& ex = exemplars.at(layer->exemplar);
-      const std::string style = opt.judge_dir + "/style.png";
-      write_png(style, layer->single_colour ? composite::touch(ex.painting.cview(), layer->channel)
-                                            : pipeline::extract(ex.painting.cview(), 0, 3));
-      judge_fixed = fmt::format("'{}' -style '{}'", opt.judge, style);
-      for (const pipeline::GuideSpec& g : layer->guides)
-        write_png(fmt::format("{}/source_{}.png", opt.judge_dir, g.pass),
-                  judge_guide(pipeline::extract_pass(ex.passes.cview(), g.pass), g.pass));
-    }
-
-    std::vector<pipeline::SequenceFlicker> flicker(opt.variants.size());
-    std::vector<double> style_sum(opt.variants.size(), 0.0);
+    const std::string judge_fixed = judging ? judge_setup(shot, *layer, opt) : std::string();
+    if (!opt.save.empty()) std::filesystem::create_directories(opt.save);
     int judged = 0;
     Image<float> prev_passes = source->passes(first);
     for (int f = first + 1; f <= last; ++f) {
       Image<float> passes = source->passes(f);
-      const pipeline::Layer& l = *layer;
-      for (std::size_t v = 0; v < opt.variants.size(); ++v) {
-        const Image<float> cur = stores[v].read_layer(l, f), prev = stores[v].read_layer(l, f - 1);
-        const int mask_channel = cur.channels() > value_channels ? value_channels : -1;
-        flicker[v].add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
-                                               prev_passes.cview(), mask_channel));
-      }
+      for (Variant& v : variants)
+        measure_frame(v, variants[0], *layer, passes, prev_passes, f, opt);
       if (judging && (f - first) % opt.judge_every == opt.judge_every / 2) {
-        std::string guides;
-        for (const pipeline::GuideSpec& g : l.guides) {
-          const std::string tgt = fmt::format("{}/target_{}_{:04d}.png", opt.judge_dir, g.pass, f);
-          write_png(tgt, judge_guide(pipeline::extract_pass(passes.cview(), g.pass), g.pass));
-          guides += fmt::format(" -guide '{}/source_{}.png' '{}' -weight {}", opt.judge_dir, g.pass,
-                                tgt, g.weight);
-        }
-        for (std::size_t v = 0; v < opt.variants.size(); ++v) {
-          const Image<float> cur = stores[v].read_layer(l, f);
-          Image<float> out(cur.width(), cur.height(), value_channels);
-          for (int y = 0; y < cur.height(); ++y)
-            for (int x = 0; x < cur.width(); ++x) {
-              const float a = cur.channels() > value_channels ? cur(x, y, value_channels) : 1.0f;
-              for (int c = 0; c < value_channels; ++c) out(x, y, c) = a * cur(x, y, c) + (1.0f - a);
-            }
-          const std::string path =
-              fmt::format("{}/{}_{:04d}.png", opt.judge_dir, opt.variants[v], f);
-          write_png(path, out);
-          const double s =
-              run_judge(judge_fixed + guides + fmt::format(" -output-to-judge '{}'", path));
-          std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f\n", f,
-                       opt.variants[v].c_str(), s);
-          style_sum[v] += s;
-        }
+        judge_frame(judge_fixed, *layer, passes, f, variants, opt);
         ++judged;
       }
       prev_passes = std::move(passes);
     }
-
-    std::printf("temporal_bench: layer '%s', %dx%d, frames %d-%d, %d threads%s\n",
-                opt.layer.c_str(), opt.width, opt.height, first, last, thread_count(),
-                judging ? fmt::format(", judge on {} frames", judged).c_str() : "");
-    std::printf("%-14s %9s %10s %10s %10s %12s %12s\n", "variant", "s/frame", "flicker", "fox",
-                "ground", "vs frame", "judge style");
-    const double base = opt.variants[0] == "frame" ? flicker[0].all.mean() : 0.0;
-    const double base_style = opt.variants[0] == "frame" && judged ? style_sum[0] / judged : 0.0;
-    for (std::size_t v = 0; v < opt.variants.size(); ++v) {
-      const double style = judged ? style_sum[v] / judged : 0.0;
-      std::printf(
-          "%-14s %9.2f %10.5f %10.5f %10.5f %11.2fx %12s\n", opt.variants[v].c_str(),
-          seconds[v] / opt.frames, flicker[v].all.mean(), flicker[v].objects.mean(),
-          flicker[v].ground.mean(), base > 0 ? flicker[v].all.mean() / base : 0.0,
-          judged ? fmt::format("{:.6f}{}", style,
-                               base_style > 0
-                                   ? fmt::format(" ({:+.1f} %)", 100.0 * (style / base_style - 1))
-                                   : "")
-                       .c_str()
-                 : "-");
-    }
+    print_table(variants, opt, first, last, judged);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "temporal_bench: %s\n", e.what());
     return 1;
