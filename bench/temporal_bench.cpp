@@ -15,11 +15,13 @@
 //
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
-// `rest_position_noconf` (temporal_confidence = false). --error-* and --erode set the
-// confidence's parameters (temporal::ConfidenceParams). The judge is ../shared/tools/judge
-// (build it with its build.sh). Its guides are the layer's guides (normal mapped to [0,1],
-// diffuse) with the layer's weights; outside the layer's mask the output is taken as white on
-// every variant alike.
+// `rest_position_noconf` (temporal_confidence = false); NAME@W gives that variant the temporal
+// weight W (`rest_position_noconf@1`: the example before the confidence). --error-* and --erode
+// set the confidence's parameters (temporal::ConfidenceParams), --temporal-weight the temporal
+// weight of every temporal variant without @W. The judge is ../shared/tools/judge (build it
+// with its build.sh). Its guides are the layer's guides (normal mapped to [0,1], diffuse) with
+// the layer's weights; outside the layer's mask the output is taken as white on every variant
+// alike.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -54,8 +56,8 @@ const std::vector<std::string> kVariants = {"frame", "position", "rest_position"
 struct Options {
   int width = 960, height = 540, frames = 48, threads = 0, judge_every = 8;
   std::string layer = "base", judge, judge_dir = "/tmp/emaki_temporal_judge", save;
-  std::vector<std::string> variants = {"frame", "position", "rest_position_noconf",
-                                       "rest_position"};
+  std::vector<std::string> variants = {"frame", "rest_position_noconf@1", "rest_position_noconf",
+                                       "position", "rest_position"};
   temporal::ConfidenceParams confidence;
   float temporal_weight = -1.0f;  // -1: the example's
 };
@@ -70,11 +72,13 @@ struct Options {
   std::exit(2);
 }
 
+// NAME or NAME@WEIGHT (the temporal weight of that variant).
 std::vector<std::string> parse_variants(const std::string& v) {
   std::vector<std::string> out;
   std::stringstream ss(v);
   for (std::string s; std::getline(ss, s, ',');) {
-    if (std::find(kVariants.begin(), kVariants.end(), s) == kVariants.end())
+    const std::string name = s.substr(0, s.find('@'));
+    if (std::find(kVariants.begin(), kVariants.end(), name) == kVariants.end())
       usage("bad variant " + s);
     out.push_back(s);
   }
@@ -172,13 +176,16 @@ struct Variant {
   double style_sum = 0.0;
 };
 
-pipeline::Layer variant_layer(pipeline::Layer l, const std::string& name, const Options& o) {
+pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, const Options& o) {
+  const std::size_t at = variant.find('@');
+  const std::string name = variant.substr(0, at);
   l.temporal.enabled = name != "frame";
   l.temporal.guide = name.rfind("position", 0) == 0 ? pipeline::AdvectionGuide::kPosition
                                                     : pipeline::AdvectionGuide::kRestPosition;
   l.temporal.confidence = name.find("_noconf") == std::string::npos;
   l.temporal.confidence_params = o.confidence;
   if (o.temporal_weight >= 0.0f) l.temporal.weight = o.temporal_weight;
+  if (at != std::string::npos) l.temporal.weight = std::strtof(variant.c_str() + at + 1, nullptr);
   return l;
 }
 
@@ -274,7 +281,7 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
   std::printf("temporal_bench: layer '%s', %dx%d, frames %d-%d, %d threads%s\n", opt.layer.c_str(),
               opt.width, opt.height, first, last, thread_count(),
               judged ? fmt::format(", judge on {} frames", judged).c_str() : "");
-  std::printf("%-21s %8s %9s %9s %9s %9s %12s %9s %9s %9s\n", "variant", "s/frame", "flicker",
+  std::printf("%-24s %8s %9s %9s %9s %9s %12s %9s %9s %9s\n", "variant", "s/frame", "flicker",
               "fox", "ground", "vs frame", "judge style", "ghost", "diff hid", "diff vis");
   const Variant& base = variants[0];
   const bool ref = base.name == "frame";
@@ -288,7 +295,7 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
                                  : "")
                : "-";
     const bool ghosted = ref && v.layer.temporal.enabled;
-    std::printf("%-21s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s\n", v.name.c_str(),
+    std::printf("%-24s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s\n", v.name.c_str(),
                 v.seconds / opt.frames, v.flicker.all.mean(), v.flicker.objects.mean(),
                 v.flicker.ground.mean(), ref ? v.flicker.all.mean() / base.flicker.all.mean() : 0.0,
                 style_text.c_str(),

@@ -42,9 +42,9 @@ struct ConfidenceParams {
   // full confidence up to error_full, none from error_none, linear between.
   float error_full = 0.02f;
   float error_none = 0.08f;
-  // Shrink the confident region by this many pixels (a patch centred there then sees no
-  // untrusted pixel); 0: none.
-  int erode = 0;
+  // Shrink the confident region by this many pixels, so that patches centred next to an
+  // untrusted pixel do not carry it either (the weight map applies at patch centres); 0: none.
+  int erode = 1;
 };
 
 // visible x (1 - foreign) x the error ramp, eroded. `error`: the advection's per-pixel patch

@@ -102,6 +102,7 @@ TEST(Confidence, ErrorRampAndErosion) {
   visible(0, 0) = 0;
   foreign(1, 0) = 0.25f;
   ConfidenceParams cp;
+  cp.erode = 0;
   const float rms_to_error = 65025.0f * 9.0f;  // patch 3
   error(2, 0) = cp.error_full * cp.error_full * rms_to_error;
   const float mid = 0.5f * (cp.error_full + cp.error_none);
