@@ -343,6 +343,24 @@ TEST_F(OutputSafety, SingleColourToggleRedoesTheLayer) {
   EXPECT_EQ(io::read_image_float(p("out/layers/base/base_0001.exr")).channels(), 1 + 1);
 }
 
+// The confidence decides the temporal frames: turning it off redoes the layer's temporal frame,
+// and `qa ghost` measures the finished layer either way.
+TEST_F(OutputSafety, TemporalConfidenceToggleRedoesTheLayer) {
+  ShotText t;
+  write_shot(t);
+  expect_ok(emaki("run " + p("shot.toml")));
+  const test::CliResult ghost = emaki("qa ghost " + p("shot.toml") + " --layer base");
+  expect_ok(ghost);
+  EXPECT_NE(ghost.out.find("\"ghost_share\": "), std::string::npos) << ghost.out;
+  t.base_extra = "temporal_confidence = false";
+  write_shot(t);
+  const test::CliResult r = emaki("run " + p("shot.toml"));
+  expect_ok(r);
+  EXPECT_NE(r.err.find("2 layer-frames synthesized, 2 already finished"), std::string::npos)
+      << r.err;
+  expect_ok(emaki("qa ghost " + p("shot.toml") + " --layer base"));
+}
+
 TEST_F(OutputSafety, QaFlickerAfterAResizeSaysToRunAgain) {
   ShotText t;
   write_shot(t);
