@@ -8,20 +8,22 @@
 // --save, the variants' layer frames as PNGs.
 //
 //   temporal_bench [--size 960x540] [--frames 48] [--layer base]
-//                  [--variants frame,rest_position_noconf,rest_position,...]
-//                  [--error-full X] [--error-none Y] [--erode N] [--temporal-weight W]
+//                  [--variants frame,rest_position_noconf_uniform@1,rest_position,...]
+//                  [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N]
+//                  [--temporal-weight W]
 //                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--save DIR]
 //                  [--threads N]
 //
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
-// `rest_position_noconf` (temporal_confidence = false); NAME@W gives that variant the temporal
-// weight W (`rest_position_noconf@1`: the example before the confidence). --error-* and --erode
-// set the confidence's parameters (temporal::ConfidenceParams), --temporal-weight the temporal
-// weight of every temporal variant without @W. The judge is ../shared/tools/judge (build it
-// with its build.sh). Its guides are the layer's guides (normal mapped to [0,1], diffuse) with
-// the layer's weights; outside the layer's mask the output is taken as white on every variant
-// alike.
+// `rest_position_noconf` (temporal_confidence = false); a `_uniform` suffix keeps the layer's
+// uniformity at temporal frames (temporal_uniformity = uniformity), @W gives the variant the
+// temporal weight W (`rest_position_noconf_uniform@1`: the example before the confidence).
+// --error-*, --foreign-none and --erode set the confidence's parameters
+// (temporal::ConfidenceParams), --temporal-weight the temporal weight of every temporal variant
+// without @W. The judge is ../shared/tools/judge (build it with its build.sh). Its guides are
+// the layer's guides (normal mapped to [0,1], diffuse) with the layer's weights; outside the
+// layer's mask the output is taken as white on every variant alike.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -56,28 +58,39 @@ const std::vector<std::string> kVariants = {"frame", "position", "rest_position"
 struct Options {
   int width = 960, height = 540, frames = 48, threads = 0, judge_every = 8;
   std::string layer = "base", judge, judge_dir = "/tmp/emaki_temporal_judge", save;
-  std::vector<std::string> variants = {"frame", "rest_position_noconf@1", "rest_position_noconf",
-                                       "position", "rest_position"};
+  std::vector<std::string> variants = {"frame", "rest_position_noconf_uniform@1",
+                                       "rest_position_uniform", "position", "rest_position"};
   temporal::ConfidenceParams confidence;
   float temporal_weight = -1.0f;  // -1: the example's
 };
 
 [[noreturn]] void usage(const std::string& why) {
-  std::fprintf(stderr,
-               "temporal_bench: %s\nusage: temporal_bench [--size WxH] [--frames N] [--layer NAME] "
-               "[--variants a,b,...] [--error-full X] [--error-none Y] [--erode N] "
-               "[--temporal-weight W] [--judge PATH] "
-               "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",
-               why.c_str());
+  std::fprintf(
+      stderr,
+      "temporal_bench: %s\nusage: temporal_bench [--size WxH] [--frames N] [--layer NAME] "
+      "[--variants a,b,...] [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N] "
+      "[--temporal-weight W] [--judge PATH] "
+      "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",
+      why.c_str());
   std::exit(2);
 }
 
-// NAME or NAME@WEIGHT (the temporal weight of that variant).
+// A variant's base name: without @WEIGHT and _uniform.
+std::string base_name(const std::string& variant) {
+  std::string name = variant.substr(0, variant.find('@'));
+  const std::string uniform = "_uniform";
+  if (name.size() > uniform.size() &&
+      name.compare(name.size() - uniform.size(), uniform.size(), uniform) == 0)
+    name.resize(name.size() - uniform.size());
+  return name;
+}
+
+// NAME[_uniform][@WEIGHT].
 std::vector<std::string> parse_variants(const std::string& v) {
   std::vector<std::string> out;
   std::stringstream ss(v);
   for (std::string s; std::getline(ss, s, ',');) {
-    const std::string name = s.substr(0, s.find('@'));
+    const std::string name = base_name(s);
     if (std::find(kVariants.begin(), kVariants.end(), name) == kVariants.end())
       usage("bad variant " + s);
     out.push_back(s);
@@ -103,6 +116,8 @@ Options parse(int argc, char** argv) {
       o.confidence.error_full = std::strtof(v.c_str(), nullptr);
     } else if (a == "--error-none") {
       o.confidence.error_none = std::strtof(v.c_str(), nullptr);
+    } else if (a == "--foreign-none") {
+      o.confidence.foreign_none = std::strtof(v.c_str(), nullptr);
     } else if (a == "--erode") {
       o.confidence.erode = std::atoi(v.c_str());
     } else if (a == "--temporal-weight") {
@@ -178,7 +193,7 @@ struct Variant {
 
 pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, const Options& o) {
   const std::size_t at = variant.find('@');
-  const std::string name = variant.substr(0, at);
+  const std::string name = base_name(variant);
   l.temporal.enabled = name != "frame";
   l.temporal.guide = name.rfind("position", 0) == 0 ? pipeline::AdvectionGuide::kPosition
                                                     : pipeline::AdvectionGuide::kRestPosition;
@@ -186,6 +201,7 @@ pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, con
   l.temporal.confidence_params = o.confidence;
   if (o.temporal_weight >= 0.0f) l.temporal.weight = o.temporal_weight;
   if (at != std::string::npos) l.temporal.weight = std::strtof(variant.c_str() + at + 1, nullptr);
+  if (variant.find("_uniform") != std::string::npos) l.temporal.uniformity = l.synth.uniformity;
   return l;
 }
 

@@ -115,8 +115,10 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
   l.add(p + "temporal", fmt::format("{} weight {} guide {}", layer.temporal.enabled,
                                     layer.temporal.weight, int(layer.temporal.guide)));
   const temporal::ConfidenceParams& c = layer.temporal.confidence_params;
-  l.add(p + "temporal.confidence", fmt::format("{} error {} {} erode {}", layer.temporal.confidence,
-                                               c.error_full, c.error_none, c.erode));
+  l.add(
+      p + "temporal.confidence",
+      fmt::format("{} error {} {} foreign {} erode {} uniformity {}", layer.temporal.confidence,
+                  c.error_full, c.error_none, c.foreign_none, c.erode, layer.temporal.uniformity));
   l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
                                 layer.mask.dilate, layer.mask.threshold));
   return l.m;

@@ -100,7 +100,10 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
   // search-vote iteration at the finest level instead of two keeps flicker and the judge's
   // style energy within their bars (measured on the example, docs/temporal.md) and saves about
   // a quarter of the time per frame.
-  if (!advected.value.empty()) params.finest_search_vote_iters = 1;
+  if (!advected.value.empty()) {
+    params.finest_search_vote_iters = 1;
+    params.uniformity = l.temporal.uniformity;
+  }
   synth::Result r = synth::synthesize(inputs, params);
   return std::move(r.image);
 }

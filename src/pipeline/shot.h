@@ -104,6 +104,10 @@ struct TemporalSpec {
   // hidden at t-1 (temporal/confidence.h). Off: full weight everywhere, as before it existed.
   bool confidence = true;
   temporal::ConfidenceParams confidence_params;  // not in the shot file: measured defaults
+  // The main transfer's uniformity at temporal frames (the first frame uses SynthSpec's): with
+  // the temporal guide holding the layout, the term only pushes the exemplar's least used
+  // patches into wherever that guide is weakest, where the chain then keeps them.
+  float uniformity = 0.0f;
 };
 
 struct SynthSpec {

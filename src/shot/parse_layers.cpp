@@ -212,6 +212,7 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   l.temporal.guide =
       r.choice("advection", pipeline::AdvectionGuide::kRestPosition, kAdvectionGuides);
   l.temporal.confidence = r.boolean("temporal_confidence", l.temporal.confidence);
+  l.temporal.uniformity = r.real("temporal_uniformity", l.temporal.uniformity);
   l.mask = d.mask;
   l.mask.kind = r.choice("mask", d.mask.kind, kMaskKinds);
   l.mask.dilate = r.real("mask_dilate", l.mask.dilate);

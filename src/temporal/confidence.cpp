@@ -162,7 +162,8 @@ Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& forei
         const float rms = float(std::sqrt(std::max(0.0, double(error(x, y)) * norm)));
         const float ramp =
             std::clamp((cp.error_none - rms) / (cp.error_none - cp.error_full), 0.0f, 1.0f);
-        c(x, y) = visible(x, y) ? (1.0f - foreign(x, y)) * ramp : 0.0f;
+        const float own = std::clamp(1.0f - foreign(x, y) / cp.foreign_none, 0.0f, 1.0f);
+        c(x, y) = visible(x, y) ? own * ramp : 0.0f;
       }
   });
   if (cp.erode <= 0) return c;

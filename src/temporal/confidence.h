@@ -1,9 +1,11 @@
 // Where the advected previous frame can guide the current one. B'adv is B'(t-1) carried along
 // the advection's field; at a pixel whose surface point was hidden at t-1 (ground uncovered by
-// a swinging tail, a limb passing in front) there is nothing right to carry, and B'adv holds
-// the touch of whatever covered it. The confidence is 1 where the advection's own evidence says
-// the surface was visible and carried from itself, 0 where it was not, and the main transfer
-// uses it as the temporal guide's weight map.
+// a swinging tail, a limb passing in front) there is nothing right to carry, and B'adv holds a
+// stretched copy of what lay next to the cover, bled into by the cover's own patches: kept by
+// the main transfer, it becomes a streak that trails the cover (docs/temporal.md). The
+// confidence is 1 where the advection's own evidence says the surface was visible and carried
+// from itself, 0 where it was not, and the main transfer uses it as the temporal guide's
+// weight map.
 #pragma once
 
 #include "core/image.h"
@@ -18,12 +20,13 @@ struct Surfaces {
   ImageView<const float> motion;  // frame t, 2 channels: pixels from here to the same point at t-1
 };
 
-// 1 where the surface point a pixel of frame t shows was visible at t-1: one of the (up to
-// four) pixels a bilinear sample where its motion leads in t-1 reads shows the same object with a
-// rest position within `tolerance` pixel footprints of it (the largest rest-position step to a
-// neighbour of the same object at t). 0 where it was hidden or outside the frame. This is `emaki qa
-// flicker`'s occlusion test (same object around the motion's end) with the rest position added, so
-// that a limb passing in front of its own body counts as a cover too.
+// 1 where the surface point a pixel of frame t shows was visible at t-1: one of the pixels
+// (one to four) that a bilinear sample at the end of its motion vector reads in t-1 shows the
+// same object with a rest position within `tolerance` pixel footprints of it (a footprint: the
+// largest rest-position step to a neighbour of the same object at t). 0 where it was hidden or
+// outside the frame. This is `emaki qa flicker`'s occlusion test (the same object around the
+// motion's end) with the rest position added, so that a limb passing in front of its own body
+// counts as a cover too.
 Image<uint8_t> visible_before(const Surfaces& s, float tolerance = 3.0f);
 
 // For each pixel of frame t, the share of its B'adv value that came from another object than
@@ -42,12 +45,14 @@ struct ConfidenceParams {
   // full confidence up to error_full, none from error_none, linear between.
   float error_full = 0.02f;
   float error_none = 0.08f;
+  // The foreign share: no confidence from foreign_none on, linear below it (1: 1 - foreign).
+  float foreign_none = 1.0f;
   // Shrink the confident region by this many pixels, so that patches centred next to an
   // untrusted pixel do not carry it either (the weight map applies at patch centres); 0: none.
   int erode = 1;
 };
 
-// visible x (1 - foreign) x the error ramp, eroded. `error`: the advection's per-pixel patch
+// visible x the foreign ramp x the error ramp, eroded. `error`: the advection's per-pixel patch
 // error in EbSynth units (synth::Result::error) over guides whose weights sum to 1, which makes
 // sqrt(error / (65025 x patch_size^2)) the RMS guide difference; `patch_size` the advection's.
 Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& foreign,
