@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
+#include "synth/ebsynth_rules.h"
 #include "synth/synthesizer.h"
 
 namespace emaki::app {
@@ -71,35 +72,13 @@ void check_output_path(const std::string& opt, const std::string& path) {
   }
 }
 
-}  // namespace
-
-int run_synth(const Args& argv) {
-  const SynthArgs args = parse_synth_args(argv);
-  if (args.help) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  const std::string& style_path = args.style_path;
-  const std::string& output = args.output;
-  const std::string& mask_path = args.mask_path;
-  const std::string& nnf_out = args.nnf_out;
-  const std::string& error_out = args.error_out;
-  const std::string& depth = args.depth;
-  const std::vector<SynthGuideArg>& guides = args.guides;
-  synth::Params params = args.params;
-  const bool quiet = args.quiet;
-
-  // Fail on an unwritable output before any long work.
-  check_output_path("-output", output);
-  if (!nnf_out.empty()) check_output_path("--nnf-out", nnf_out);
-  if (!error_out.empty()) check_output_path("--error-out", error_out);
-  set_thread_count(args.threads);
-
-  const auto t0 = std::chrono::steady_clock::now();
-  // Decode every file at once (PNG decoding is serial per file); report the first failure in
-  // command-line order so the error does not depend on timing.
-  std::vector<std::string> paths{style_path};
-  for (const auto& g : guides) paths.insert(paths.end(), {g.source, g.target});
+// The decoded files: style, then each guide's source and target, then the mask if any.
+// PNG decoding is serial per file, so the files are decoded at once; the first failure is
+// reported in command-line order so that the error does not depend on timing.
+std::vector<io::AnyImage> read_files(const SynthArgs& args) {
+  std::vector<std::string> paths{args.style_path};
+  for (const auto& g : args.guides) paths.insert(paths.end(), {g.source, g.target});
+  if (!args.mask_path.empty()) paths.push_back(args.mask_path);
   std::vector<io::AnyImage> files(paths.size());
   std::vector<std::exception_ptr> failures(paths.size());
   parallel_for(int64_t(paths.size()), 1, [&](int64_t a, int64_t b) {
@@ -113,97 +92,33 @@ int run_synth(const Args& argv) {
   });
   for (const auto& f : failures)
     if (f) std::rethrow_exception(f);
-  io::AnyImage style = std::move(files[0]);
-  style = with_channels(std::move(style), effective_channels(style));
-  if (style.channels() > 4) throw Error(style_path, "style must have 1 to 4 channels");
+  return files;
+}
 
-  std::vector<io::AnyImage> loaded;
-  loaded.reserve(guides.size() * 2);
-  synth::Inputs in;
-  in.style = plane_of(style);
-  in.style_name = style_path;
-  for (std::size_t k = 0; k < guides.size(); ++k) {
-    const SynthGuideArg& g = guides[k];
-    io::AnyImage s = std::move(files[1 + 2 * k]);
-    io::AnyImage t = std::move(files[2 + 2 * k]);
-    if (s.width() != style.width() || s.height() != style.height())
-      throw Error(g.source,
-                  fmt::format("source guide is {}x{} but the style '{}' is {}x{}", s.width(),
-                              s.height(), style_path, style.width(), style.height()));
-    const int nc = std::max(effective_channels(s), effective_channels(t));
-    if (nc > 4) throw Error(g.source, "a guide must have 1 to 4 channels");
-    loaded.push_back(with_channels(std::move(s), std::min(nc, 4)));
-    loaded.push_back(with_channels(std::move(t), std::min(nc, 4)));
-    const io::AnyImage& ls = loaded[loaded.size() - 2];
-    const io::AnyImage& lt = loaded.back();
-    if (ls.channels() != lt.channels())
-      throw Error(g.target, fmt::format("has {} channels but its source guide '{}' has {}",
-                                        lt.channels(), g.source, ls.channels()));
-    synth::GuidePair gp;
-    gp.name = g.target;
-    gp.source = plane_of(ls);
-    gp.target = plane_of(lt);
-    gp.weight = g.weight;
-    in.guides.push_back(gp);
+// EbSynth's rules (synth/ebsynth_rules.h) over the decoded files, named by their paths.
+synth::RuledInputs ruled_inputs(const SynthArgs& args, const std::vector<io::AnyImage>& files) {
+  std::vector<synth::NamedGuide> guides;
+  for (std::size_t k = 0; k < args.guides.size(); ++k) {
+    const SynthGuideArg& g = args.guides[k];
+    guides.push_back(
+        {{plane_of(files[1 + 2 * k]), g.source}, {plane_of(files[2 + 2 * k]), g.target}, g.weight});
   }
-  // Name the right file when sizes disagree.
-  for (std::size_t k = 1; k < in.guides.size(); ++k)
-    if (synth::plane_width(in.guides[k].target) != synth::plane_width(in.guides[0].target) ||
-        synth::plane_height(in.guides[k].target) != synth::plane_height(in.guides[0].target))
-      throw Error(guides[k].target,
-                  fmt::format("target guide is {}x{} but '{}' is {}x{}",
-                              synth::plane_width(in.guides[k].target),
-                              synth::plane_height(in.guides[k].target), guides[0].target,
-                              synth::plane_width(in.guides[0].target),
-                              synth::plane_height(in.guides[0].target)));
-  io::AnyImage mask;
-  if (!mask_path.empty()) {
-    mask = io::read_image(mask_path);
-    in.target_mask = plane_of(mask);
-    in.target_mask_name = mask_path;
-  }
-  params.style_weight = args.style_weight;
+  std::optional<synth::NamedPlane> mask;
+  if (!args.mask_path.empty()) mask = synth::NamedPlane{plane_of(files.back()), args.mask_path};
+  return synth::apply_ebsynth_rules({plane_of(files[0]), args.style_path}, guides, mask);
+}
 
-  synth::OutputRequest req;
-  req.nnf = !nnf_out.empty();
-  req.error = !error_out.empty();
-  synth::Synthesizer synthesizer(in, params);
-  // The guides are packed into the engine's features now; free them before the long part.
-  in.guides.clear();
-  loaded.clear();
-  loaded.shrink_to_fit();
-  synth::Result res = synthesizer.run(req);
-  const auto t1 = std::chrono::steady_clock::now();
+io::SampleFormat output_format(const std::string& depth, io::PixelType style_type) {
+  if (depth == "8") return io::SampleFormat::kU8;
+  if (depth == "16") return io::SampleFormat::kU16;
+  if (depth == "float") return io::SampleFormat::kFloat;
+  if (style_type == io::PixelType::kU8) return io::SampleFormat::kU8;
+  if (style_type == io::PixelType::kU16) return io::SampleFormat::kU16;
+  return io::SampleFormat::kFloat;
+}
 
-  io::WriteOptions wo;
-  if (depth == "8")
-    wo.format = io::SampleFormat::kU8;
-  else if (depth == "16")
-    wo.format = io::SampleFormat::kU16;
-  else if (depth == "float")
-    wo.format = io::SampleFormat::kFloat;
-  else if (style.type() == io::PixelType::kU8)
-    wo.format = io::SampleFormat::kU8;
-  else if (style.type() == io::PixelType::kU16)
-    wo.format = io::SampleFormat::kU16;
-  else
-    wo.format = io::SampleFormat::kFloat;
-  // A one-channel style whose file was RGB is written back as RGB, as EbSynth does.
-  Image<float> out_img;
-  const int ns = synth::plane_channels(in.style);
-  if (ns == 1 && res.image.channels() <= 2) {
-    const bool alpha = res.image.channels() == 2;
-    out_img.reset(res.image.width(), res.image.height(), alpha ? 4 : 3);
-    for (int y = 0; y < res.image.height(); ++y)
-      for (int x = 0; x < res.image.width(); ++x) {
-        for (int c = 0; c < 3; ++c) out_img(x, y, c) = res.image(x, y, 0);
-        if (alpha) out_img(x, y, 3) = res.image(x, y, 1);
-      }
-  } else {
-    out_img = std::move(res.image);
-  }
-  io::write_image(output, out_img.cview(), wo);
-  if (req.nnf) {
+void write_field_and_error(const SynthArgs& args, const synth::Result& res) {
+  if (!args.nnf_out.empty()) {
     Image<float> f(res.nnf.width(), res.nnf.height(), 2);
     for (int y = 0; y < f.height(); ++y)
       for (int x = 0; x < f.width(); ++x)
@@ -211,19 +126,63 @@ int run_synth(const Args& argv) {
     io::WriteOptions o;
     o.format = io::SampleFormat::kFloat;
     o.channel_names = {"nnf.X", "nnf.Y"};
-    io::write_image(nnf_out, f.cview(), o);
+    io::write_image(args.nnf_out, f.cview(), o);
   }
-  if (req.error) {
+  if (!args.error_out.empty()) {
     io::WriteOptions o;
     o.format = io::SampleFormat::kFloat;
     o.channel_names = {"error.Y"};
-    io::write_image(error_out, res.error.cview(), o);
+    io::write_image(args.error_out, res.error.cview(), o);
   }
-  if (!quiet)
+}
+
+}  // namespace
+
+int run_synth(const Args& argv) {
+  const SynthArgs args = parse_synth_args(argv);
+  if (args.help) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  // Fail on an unwritable output before any long work.
+  check_output_path("-output", args.output);
+  if (!args.nnf_out.empty()) check_output_path("--nnf-out", args.nnf_out);
+  if (!args.error_out.empty()) check_output_path("--error-out", args.error_out);
+  set_thread_count(args.threads);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<io::AnyImage> files = read_files(args);
+  const auto t_read = std::chrono::steady_clock::now();
+  synth::RuledInputs ruled = ruled_inputs(args, files);
+  synth::Params params = args.params;
+  params.style_weight = args.style_weight;
+  synth::OutputRequest req;
+  req.nnf = !args.nnf_out.empty();
+  req.error = !args.error_out.empty();
+  synth::Synthesizer synthesizer(ruled.inputs, params);
+  // The guides are packed into the engine's features now; free them before the long part.
+  ruled.release_guides();
+  for (std::size_t i = 1; i < 1 + 2 * args.guides.size(); ++i) files[i] = io::AnyImage();
+  synth::Result res = synthesizer.run(req);
+  const auto t1 = std::chrono::steady_clock::now();
+
+  io::WriteOptions wo;
+  wo.format = output_format(args.depth, files[0].type());
+  // A one-channel style (an RGB file whose channels are equal, say) is written back as RGB, as
+  // EbSynth does.
+  const int ns = synth::plane_channels(ruled.inputs.style);
+  const Image<float> out_img = ns == 1 ? synth::gray_to_rgb(res.image) : std::move(res.image);
+  io::write_image(args.output, out_img.cview(), wo);
+  write_field_and_error(args, res);
+  if (!args.quiet) {
+    using seconds = std::chrono::duration<double>;
     std::fprintf(stderr,
-                 "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
-                 out_img.width(), out_img.height(), style.width(), style.height(), ns,
-                 guides.size(), res.pyramid_levels, std::chrono::duration<double>(t1 - t0).count());
+                 "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s "
+                 "(reading %.3f s, synthesis %.3f s)\n",
+                 out_img.width(), out_img.height(), files[0].width(), files[0].height(), ns,
+                 args.guides.size(), res.pyramid_levels, seconds(t1 - t0).count(),
+                 seconds(t_read - t0).count(), seconds(t1 - t_read).count());
+  }
   return 0;
 }
 

@@ -1,4 +1,4 @@
-// `emaki synth`'s argument parser and EbSynth's channel rules (see synth_args.h).
+// `emaki synth`'s argument parser (see synth_args.h).
 #include "apps/emaki/synth_args.h"
 
 #include <fmt/format.h>
@@ -86,7 +86,7 @@ SynthArgs parse_synth_args(const std::vector<std::string>& args) {
     } else if (a == "-weight") {
       const float w = parse_float(a, need(i, a));
       if (!last_weight) throw Error("-weight", "must follow a -style or -guide option");
-      if (w > 1e6f) throw Error("-weight", "must be <= 1e6");
+      if (w > kMaxWeight) throw Error("-weight", "must be <= 1e6");
       if (w < 0.0f) throw Error("-weight", "must be >= 0");
       *last_weight = w;
     } else if (a == "-output") {
@@ -155,52 +155,6 @@ SynthArgs parse_synth_args(const std::vector<std::string>& args) {
   if (guides.empty()) throw Error("-guide", "at least one guide pair is required");
 
   return r;
-}
-
-int effective_channels(const io::AnyImage& im) {
-  const int nc = im.channels();
-  const int w = im.width(), h = im.height();
-  auto opaque = [&](int c) {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        if (im.value(x, y, c) != 1.0f) return false;
-    return true;
-  };
-  auto gray = [&]() {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const float r = im.value(x, y, 0);
-        if (im.value(x, y, 1) != r || im.value(x, y, 2) != r) return false;
-      }
-    return true;
-  };
-  if (nc == 4) return opaque(3) ? (gray() ? 1 : 3) : 4;
-  if (nc == 3) return gray() ? 1 : 3;
-  if (nc == 2) return opaque(1) ? 1 : 2;
-  return nc;
-}
-
-io::AnyImage with_channels(io::AnyImage im, int channels) {
-  const int have = im.channels();
-  if (have == channels) return im;
-  if (have > channels) return im.select_channels(0, channels);
-  io::AnyImage out;
-  std::visit(
-      [&](const auto& src) {
-        using T = std::decay_t<decltype(src(0, 0))>;
-        Image<T> o(src.width(), src.height(), channels);
-        const bool gray = have <= 2;
-        for (int y = 0; y < src.height(); ++y)
-          for (int x = 0; x < src.width(); ++x)
-            for (int c = 0; c < channels; ++c) {
-              int from = std::min(c, have - 1);
-              if (gray) from = c < 3 ? 0 : have - 1;
-              o(x, y, c) = src(x, y, from);
-            }
-        out.image = std::move(o);
-      },
-      im.image);
-  return out;
 }
 
 }  // namespace emaki::app

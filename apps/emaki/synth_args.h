@@ -1,11 +1,11 @@
 // `emaki synth`'s command line, parsed without touching a file (so it can be fuzzed and
-// tested alone), and EbSynth's channel rules over loaded images.
+// tested alone). EbSynth's channel rules over the loaded images are synth/ebsynth_rules.h.
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
+#include "synth/ebsynth_rules.h"
 #include "synth/synthesizer.h"
 
 namespace emaki::app {
@@ -26,24 +26,16 @@ struct SynthArgs {
   bool quiet = false;
 };
 
-// Bounds on counts a command line may ask for: a typo or a hostile script must not start a
-// run that never ends. Far above anything useful (EbSynth's own defaults are 6 and 4).
-inline constexpr int kMaxPatchSize = 65;
-inline constexpr int kMaxPyramidLevels = 32;
-inline constexpr int kMaxIterations = 1000;
-inline constexpr int kMaxThreads = 1024;
-inline constexpr int kMaxGuides = 64;
+// Bounds on counts a command line may ask for (the same as Python's, see ebsynth_rules.h).
+using synth::kMaxGuides;
+using synth::kMaxIterations;
+using synth::kMaxPatchSize;
+using synth::kMaxPyramidLevels;
+using synth::kMaxThreads;
+using synth::kMaxWeight;
 
 // Parses EbSynth's command line plus emaki's options. Throws Error naming the option; checks
 // values and required options, never files.
 SynthArgs parse_synth_args(const std::vector<std::string>& args);
-
-// EbSynth counts an RGB image whose three channels are equal everywhere as one channel, and
-// drops an alpha channel that is opaque everywhere.
-int effective_channels(const io::AnyImage& im);
-
-// Gives an image `channels` channels: keeps the first ones (effective_channels only drops
-// trailing ones), or spreads a gray image over RGB when its partner guide is in colour.
-io::AnyImage with_channels(io::AnyImage im, int channels);
 
 }  // namespace emaki::app

@@ -1,4 +1,4 @@
-// `emaki synth`'s parser alone (no files) and EbSynth's channel rules.
+// `emaki synth`'s parser alone (no files).
 #include "apps/emaki/synth_args.h"
 
 #include <gtest/gtest.h>
@@ -76,29 +76,6 @@ TEST(SynthArgs, TooManyGuides) {
   std::vector<std::string> args{"-style", "s.png"};
   for (int i = 0; i <= kMaxGuides; ++i) args.insert(args.end(), {"-guide", "a.png", "b.png"});
   EXPECT_EQ(error_of(args).rfind("-guide: at most", 0), 0u);
-}
-
-io::AnyImage rgb(int w, int h, bool gray) {
-  Image<uint8_t> im(w, h, 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) im(x, y, c) = uint8_t(gray ? x * 9 + y : x * 9 + y + c * 40);
-  io::AnyImage a;
-  a.image = std::move(im);
-  return a;
-}
-
-TEST(SynthArgs, EqualChannelRgbCountsAsOne) {
-  EXPECT_EQ(effective_channels(rgb(5, 4, true)), 1);
-  EXPECT_EQ(effective_channels(rgb(5, 4, false)), 3);
-}
-
-TEST(SynthArgs, GrayIsSpreadOverRgb) {
-  io::AnyImage g = with_channels(rgb(5, 4, true), 1);
-  ASSERT_EQ(g.channels(), 1);
-  const io::AnyImage back = with_channels(std::move(g), 3);
-  ASSERT_EQ(back.channels(), 3);
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(back.value(2, 3, c), back.value(2, 3, 0));
 }
 
 }  // namespace

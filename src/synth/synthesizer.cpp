@@ -119,16 +119,17 @@ int max_pyramid_levels(int sw, int sh, int tw, int th, int patch_size) {
 }
 
 void validate(const Inputs& in, const Params& p) {
+  using F = Error::Field;
   if (p.patch_size < 3 || p.patch_size % 2 == 0)
-    throw Error("patch size", fmt::format("must be odd and >= 3 (got {})", p.patch_size));
+    throw Error(F{"patch_size"}, fmt::format("must be odd and >= 3 (got {})", p.patch_size));
   if (!(p.uniformity >= 0.0f) || !std::isfinite(p.uniformity))
-    throw Error("uniformity", "must be a finite number >= 0");
+    throw Error(F{"uniformity"}, "must be a finite number >= 0");
   if (p.pyramid_levels == 0 || p.pyramid_levels < -1)
-    throw Error("pyramid levels", fmt::format("must be >= 1 (got {})", p.pyramid_levels));
-  if (p.search_vote_iters < -1) throw Error("search-vote iterations", "must be >= 0");
-  if (p.patch_match_iters < -1) throw Error("PatchMatch iterations", "must be >= 0");
-  if (p.search_radius < 0) throw Error("search radius", "must be >= 0 (0: the whole exemplar)");
-  if (!std::isfinite(p.style_weight)) throw Error("style weight", "must be finite");
+    throw Error(F{"pyramid_levels"}, fmt::format("must be >= 1 (got {})", p.pyramid_levels));
+  if (p.search_vote_iters < -1) throw Error(F{"search_vote_iters"}, "must be >= 0");
+  if (p.patch_match_iters < -1) throw Error(F{"patch_match_iters"}, "must be >= 0");
+  if (p.search_radius < 0) throw Error(F{"search_radius"}, "must be >= 0 (0: the whole exemplar)");
+  if (!std::isfinite(p.style_weight)) throw Error(F{"style_weight"}, "must be finite");
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
   const int ns = plane_channels(in.style);
@@ -140,9 +141,10 @@ void validate(const Inputs& in, const Params& p) {
   int tw = -1, th = -1;
   std::string first_target;
   for (const auto& g : in.guides) {
+    const std::string& source_name = g.source_name.empty() ? g.name : g.source_name;
     if (plane_width(g.source) != sw || plane_height(g.source) != sh)
-      throw Error(g.name, fmt::format("source guide is {}x{} but the style is {}x{}",
-                                      plane_width(g.source), plane_height(g.source), sw, sh));
+      throw Error(source_name, fmt::format("source guide is {}x{} but the style is {}x{}",
+                                           plane_width(g.source), plane_height(g.source), sw, sh));
     if (tw < 0) {
       tw = plane_width(g.target), th = plane_height(g.target);
       first_target = g.name;
@@ -158,7 +160,7 @@ void validate(const Inputs& in, const Params& p) {
       throw Error(g.name, fmt::format("a guide must have 1 to 4 channels (has {})", cs));
     if (!(g.weight < 0.0f || std::isfinite(g.weight)))
       throw Error(g.name, "weight must be a finite number >= 0");
-    check_finite(g.source, g.name);
+    check_finite(g.source, source_name);
     check_finite(g.target, g.name);
   }
   if (sw < p.patch_size || sh < p.patch_size)
@@ -341,6 +343,10 @@ struct Synthesizer::State {
   std::vector<LevelSchedule> schedule;
   std::vector<Level> pyr;
   bool ran = false;
+
+  void build_coarse_levels();
+  Result make_result(const Image<float>& voted, Image<int32_t>& nnf, Image<float>& err,
+                     const OutputRequest& request);
 };
 
 Synthesizer::~Synthesizer() = default;
@@ -408,21 +414,10 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
   }
 }
 
-Result Synthesizer::run(const OutputRequest& request) {
-  State& st = *state_;
-  CHECK(!st.ran);  // the pyramid is consumed by a run
-  st.ran = true;
-  const Params& params = st.params;
-  const FeatureLayout& layout = st.layout;
+// The coarse levels come from the finest features, built when the run starts rather than in the
+// constructor so that the caller has already freed the guide images.
+void Synthesizer::State::build_coarse_levels() {
   const int ns = layout.style_channels;
-  const int p = params.patch_size, r = p / 2, border = st.border;
-  const int tw = st.tw, th = st.th, levels = st.levels;
-  const PatchSsdFn ssd = best_patch_ssd();
-  std::vector<Level>& pyr = st.pyr;
-  const std::vector<LevelSchedule>& schedule = st.schedule;
-
-  // The coarse levels come from the finest features, built here rather than in the constructor
-  // so that the caller has already freed the guide images.
   for (int l = 1; l < levels; ++l) {
     Level& c = pyr[l];
     const Level& f = pyr[l - 1];
@@ -430,11 +425,11 @@ Result Synthesizer::run(const OutputRequest& request) {
     decimate_channels(f.src.cview(), c.src, 0, ns);
     c.src_style.reset(c.src.width(), c.src.height(), ns);
     if (l == 1) {
-      for_each_row(st.style, 0, st.sh, [&](int y, const float* row) {
+      for_each_row(style, 0, sh, [&](int y, const float* row) {
         if (y % 2 != 0 || y / 2 >= c.src_style.height()) return;
         for (int x = 0; x < c.src_style.width(); ++x)
           for (int k = 0; k < ns; ++k)
-            c.src_style(x, y / 2, k) = row[std::min(2 * x, st.sw - 1) * ns + k];
+            c.src_style(x, y / 2, k) = row[std::min(2 * x, sw - 1) * ns + k];
       });
     } else {
       decimate_channels(f.src_style.cview(), c.src_style, 0, ns);
@@ -448,63 +443,27 @@ Result Synthesizer::run(const OutputRequest& request) {
     pad_replicate(c.tgt, border, ns, layout.channels);
     if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
   }
+}
 
-  Image<int32_t> nnf;
-  Image<float> err;
-  Image<float> style;
-  auto source_style = [&](const Level& L, int l) -> Plane {
-    return l == 0 ? st.style : Plane(L.src_style.cview());
-  };
-  auto run_level = [&](Level& L, int l, int step, const LevelSchedule& sch, int patch,
-                       float uniformity) {
-    PatchMatchLevel pm{L.sw, L.sh, L.tw, L.th, border, &L.src, &L.tgt, &L.active, &nnf, &err};
-    if (err.width() != L.tw || err.height() != L.th) err.reset(L.tw, L.th, 1);
-    PatchMatchConfig cfg;
-    cfg.patch_size = patch;
-    cfg.uniformity = uniformity;
-    cfg.iterations = sch.patch_match_iters;
-    cfg.max_search_radius = sch.max_search_radius;
-    cfg.err_scale = layout.err_scale;
-    cfg.ssd = ssd;
-    for (int it = 0; it < sch.search_vote_iters; ++it) {
-      cfg.seed = hash_key(params.seed, uint64_t(step), uint64_t(it), uint64_t(patch));
-      compute_errors(pm, cfg);
-      run_patch_match(pm, cfg);
-      vote(source_style(L, l), nnf, err, L.active, patch, params.vote_mode, style);
-      write_style(style, layout, L.tgt, border);
-    }
-  };
-
-  for (int l = levels - 1; l >= 0; --l) {
-    Level& L = pyr[l];
-    if (params.progress) params.progress(levels - 1 - l, levels);
-    if (l == levels - 1)
-      nnf = params.init == FieldInit::kIdentity
-                ? identity_nnf(L.tw, L.th, L.sw, L.sh, r)
-                : random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
-    else
-      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
-    err.reset(L.tw, L.th, 1);
-    vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
-    write_style(style, layout, L.tgt, border);
-    run_level(L, l, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
-    if (l > 0) pyr[l] = Level();  // free the coarse level
-  }
-  if (params.extra_pass_3x3) run_level(pyr[0], 0, levels, schedule.back(), 3, 0.0f);
-
+// B' (with the mask as alpha), and the field and error map when asked for.
+Result Synthesizer::State::make_result(const Image<float>& voted, Image<int32_t>& nnf,
+                                       Image<float>& err, const OutputRequest& request) {
+  const int ns = layout.style_channels;
+  const int p = params.patch_size;
+  const PatchSsdFn ssd = best_patch_ssd();
   Result res;
   res.pyramid_levels = levels;
   res.schedule = schedule;
   const Level& F = pyr[0];
-  const int out_c = ns + (st.mask ? 1 : 0);
+  const int out_c = ns + (mask ? 1 : 0);
   res.image.reset(tw, th, out_c);
   parallel_rows(th, 32, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < tw; ++x)
-        for (int c = 0; c < ns; ++c) res.image(x, y, c) = style(x, y, c);
-    if (!st.mask) return;
-    const int mc = plane_channels(*st.mask);
-    for_each_row(*st.mask, y0, y1, [&](int y, const float* row) {
+        for (int c = 0; c < ns; ++c) res.image(x, y, c) = voted(x, y, c);
+    if (!mask) return;
+    const int mc = plane_channels(*mask);
+    for_each_row(*mask, y0, y1, [&](int y, const float* row) {
       for (int x = 0; x < tw; ++x) {
         const float a = std::clamp(row[x * mc], 0.0f, 1.0f);
         res.image(x, y, ns) = a;
@@ -532,6 +491,72 @@ Result Synthesizer::run(const OutputRequest& request) {
     res.error = std::move(err);
   }
   return res;
+}
+
+Result Synthesizer::run(const OutputRequest& request) {
+  State& st = *state_;
+  CHECK(!st.ran);  // the pyramid is consumed by a run
+  st.ran = true;
+  const Params& params = st.params;
+  const FeatureLayout& layout = st.layout;
+  const int p = params.patch_size, r = p / 2, border = st.border;
+  const int levels = st.levels;
+  const PatchSsdFn ssd = best_patch_ssd();
+  // Cancellation: polled on this thread before each level and each PatchMatch sweep.
+  const std::function<void()> poll = [&params] {
+    if (params.cancel && params.cancel()) throw Cancelled();
+  };
+  std::vector<Level>& pyr = st.pyr;
+  const std::vector<LevelSchedule>& schedule = st.schedule;
+
+  st.build_coarse_levels();
+
+  Image<int32_t> nnf;
+  Image<float> err;
+  Image<float> style;
+  auto source_style = [&](const Level& L, int l) -> Plane {
+    return l == 0 ? st.style : Plane(L.src_style.cview());
+  };
+  auto run_level = [&](Level& L, int l, int step, const LevelSchedule& sch, int patch,
+                       float uniformity) {
+    PatchMatchLevel pm{L.sw, L.sh, L.tw, L.th, border, &L.src, &L.tgt, &L.active, &nnf, &err};
+    if (err.width() != L.tw || err.height() != L.th) err.reset(L.tw, L.th, 1);
+    PatchMatchConfig cfg;
+    cfg.patch_size = patch;
+    cfg.uniformity = uniformity;
+    cfg.iterations = sch.patch_match_iters;
+    cfg.max_search_radius = sch.max_search_radius;
+    cfg.err_scale = layout.err_scale;
+    cfg.ssd = ssd;
+    cfg.before_sweep = &poll;
+    for (int it = 0; it < sch.search_vote_iters; ++it) {
+      cfg.seed = hash_key(params.seed, uint64_t(step), uint64_t(it), uint64_t(patch));
+      compute_errors(pm, cfg);
+      run_patch_match(pm, cfg);
+      vote(source_style(L, l), nnf, err, L.active, patch, params.vote_mode, style);
+      write_style(style, layout, L.tgt, border);
+    }
+  };
+
+  for (int l = levels - 1; l >= 0; --l) {
+    Level& L = pyr[l];
+    poll();
+    if (params.progress) params.progress(levels - 1 - l, levels);
+    if (l == levels - 1)
+      nnf = params.init == FieldInit::kIdentity
+                ? identity_nnf(L.tw, L.th, L.sw, L.sh, r)
+                : random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
+    else
+      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
+    err.reset(L.tw, L.th, 1);
+    vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
+    write_style(style, layout, L.tgt, border);
+    run_level(L, l, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);
+    if (l > 0) pyr[l] = Level();  // free the coarse level
+  }
+  if (params.extra_pass_3x3) run_level(pyr[0], 0, levels, schedule.back(), 3, 0.0f);
+
+  return st.make_result(style, nnf, err, request);
 }
 
 Result synthesize(const Inputs& inputs, const Params& params, const OutputRequest& request) {

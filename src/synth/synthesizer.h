@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -35,10 +36,11 @@ int plane_height(const Plane& p);
 int plane_channels(const Plane& p);
 
 struct GuidePair {
-  std::string name;      // shown in error messages (a file name, a pass name)
-  Plane source;          // A_k, the size of the style exemplar
-  Plane target;          // B_k, the size of the output
-  float weight = -1.0f;  // >= 0; negative: 1 / number of guides (EbSynth's default)
+  std::string name;              // shown in error messages (a file name, a pass name)
+  Plane source;                  // A_k, the size of the style exemplar
+  Plane target;                  // B_k, the size of the output
+  float weight = -1.0f;          // >= 0; negative: 1 / number of guides (EbSynth's default)
+  std::string source_name = {};  // names the source in errors about it alone; empty: `name`
 };
 
 enum class VoteMode {
@@ -81,6 +83,15 @@ struct Params {
   uint64_t seed = 1;
   // Optional progress callback: (level, levels).
   std::function<void(int, int)> progress;
+  // Optional cancellation hook, polled on the calling thread before each level and each
+  // PatchMatch sweep. Returning true stops the run with synth::Cancelled; returning false
+  // changes nothing (results are those of a run without the hook).
+  std::function<bool()> cancel;
+};
+
+// Thrown by Synthesizer::run when Params::cancel asked to stop.
+struct Cancelled : std::exception {
+  const char* what() const noexcept override { return "synthesis cancelled"; }
 };
 
 struct Inputs {
@@ -107,7 +118,9 @@ struct Result {
 };
 
 // Checks the inputs (sizes, channel counts, finite values, parameter ranges) and throws
-// emaki::Error naming the offending guide or parameter.
+// emaki::Error naming the offending image (its name) or parameter (an Error::Field spelt as the
+// Params member: "patch_size", "uniformity", "pyramid_levels", "search_vote_iters",
+// "patch_match_iters", "search_radius", "style_weight").
 void validate(const Inputs& inputs, const Params& params);
 
 // The schedule the synthesizer will run for these sizes and parameters.
