@@ -18,7 +18,9 @@ namespace emaki::python {
 namespace {
 
 constexpr const char* kReadDoc =
-    R"(Reads an image file: PNG (8/16-bit), EXR (half/float), TIFF, JPEG.
+    R"(read_image(path, channels=None)
+
+Reads an image file: PNG (8/16-bit), EXR (half/float), TIFF, JPEG.
 
 Args:
     path: the file (str or os.PathLike).

@@ -301,9 +301,18 @@ void bind_render(py::module_& m) {
         py::arg("softness") = spec.light.softness_deg, py::arg("ground") = spec.ground,
         py::arg("aa") = 3, py::arg("outline_width") = options.outline_width,
         py::arg("threads") = 0);
+  // The passes in channel order and their EXR channel names (docs/passes.md), for reading a
+  // pass out of a frame's file: read_image(path, channels=pass_channels["normal"]).
   std::vector<std::string> names;
-  for (const render::PassInfo& p : render::pass_table()) names.push_back(p.name);
+  py::dict channels;
+  for (const render::PassInfo& p : render::pass_table()) {
+    names.push_back(p.name);
+    std::vector<std::string> c;
+    for (int k = 0; k < p.count; ++k) c.push_back(std::string(p.name) + "." + p.suffixes[k]);
+    channels[p.name] = c;
+  }
   m.attr("pass_names") = names;
+  m.attr("pass_channels") = channels;
 }
 
 }  // namespace emaki::python

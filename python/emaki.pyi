@@ -123,7 +123,8 @@ def template(
     threads: int = 0,
 ) -> dict[str, npt.NDArray[np.float32]]: ...
 
-pass_names: list[str]
+pass_names: list[str]  # the passes render() and template() return, in channel order
+pass_channels: dict[str, list[str]]  # their EXR channel names: {'normal': ['normal.X', ...], ...}
 
 def _last_inputs() -> Mapping[str, object]: ...
 def _input_copies() -> int: ...

@@ -1,36 +1,49 @@
 #include "python/errors.h"
 
+#include <pybind11/eval.h>
+
 namespace emaki::python {
 namespace {
 
 // Created once at import, alive as long as the module (held by it, too).
-PyObject* g_error = nullptr;
 PyObject* g_input_error = nullptr;
 PyObject* g_file_error = nullptr;
 
-PyObject* new_class(py::module_& m, const char* name, const char* doc, py::tuple bases) {
-  const std::string full = std::string("emaki.") + name;
-  PyObject* cls = PyErr_NewExceptionWithDoc(full.c_str(), doc, bases.ptr(), nullptr);
-  if (!cls) throw py::error_already_set();
-  m.add_object(name, py::handle(cls));
-  return cls;
-}
+// In Python, so that FileError can be an OSError whose str() is the message (OSError's own
+// str() shows errno and filename instead).
+constexpr const char* kClasses = R"(
+class Error(Exception):
+    """Base of emaki's errors. `subject` names the argument, file or key the error is about;
+    `message` is the text without it; str() is "subject: message"."""
+    subject = ""
+    message = ""
+
+
+class InputError(Error, ValueError):
+    """A bad argument: a value out of range, an array of the wrong dtype, shape or size, a
+    non-finite value. Also a ValueError."""
+
+
+class FileError(Error, OSError):
+    """A file that cannot be read, decoded or written. Also an OSError; `filename` is the
+    file (as `subject`)."""
+    def __str__(self):
+        return self.args[0] if self.args else ""
+
+
+for _cls in (Error, InputError, FileError):
+    _cls.__module__ = "emaki"
+)";
 
 }  // namespace
 
 void bind_errors(py::module_& m) {
-  g_error = new_class(m, "Error",
-                      "Base of emaki's errors. `subject` names the argument, file or key the "
-                      "error is about; `message` is the text without it.",
-                      py::make_tuple(py::handle(PyExc_Exception)));
-  g_input_error = new_class(m, "InputError",
-                            "A bad argument: a value out of range, an array of the wrong dtype, "
-                            "shape or size, a non-finite value. Also a ValueError.",
-                            py::make_tuple(py::handle(g_error), py::handle(PyExc_ValueError)));
-  g_file_error = new_class(m, "FileError",
-                           "A file that cannot be read, decoded or written. Also an OSError; "
-                           "`filename` is the file.",
-                           py::make_tuple(py::handle(g_error), py::handle(PyExc_OSError)));
+  py::dict scope;
+  scope["__builtins__"] = py::module_::import("builtins");
+  py::exec(kClasses, scope);
+  for (const char* name : {"Error", "InputError", "FileError"}) m.attr(name) = scope[name];
+  g_input_error = py::object(scope["InputError"]).release().ptr();
+  g_file_error = py::object(scope["FileError"]).release().ptr();
 }
 
 void raise_error(const Error& e, ErrorKind kind, std::initializer_list<FieldName> fields) {
