@@ -132,9 +132,11 @@ std::vector<GuideArrays> guide_arrays(const py::sequence& guides) {
     const py::sequence pair = g;
     std::optional<float> w;
     if (py::len(pair) == 3 && !pair[2].is_none()) {
-      if (!py::isinstance<py::float_>(pair[2]) && !py::isinstance<py::int_>(pair[2]))
+      try {
+        w = pair[2].cast<float>();  // any real number, numpy scalars included
+      } catch (const py::cast_error&) {
         raise_input_error(name + "[2]", "the weight must be a number or None");
-      w = pair[2].cast<float>();
+      }
     }
     out.push_back({array_plane(pair[0], name + "[0]"), array_plane(pair[1], name + "[1]"),
                    checked_weight(w, name + "[2]")});
@@ -143,8 +145,9 @@ std::vector<GuideArrays> guide_arrays(const py::sequence& guides) {
 }
 
 uint64_t checked_seed(const py::object& seed) {
-  if (!py::isinstance<py::int_>(seed)) raise_input_error("seed", "must be an integer");
-  const unsigned long long v = PyLong_AsUnsignedLongLong(seed.ptr());
+  // Any integer, numpy's included (__index__); not a float.
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(seed.ptr()));
+  const unsigned long long v = index ? PyLong_AsUnsignedLongLong(index.ptr()) : 0;
   if (PyErr_Occurred()) {
     PyErr_Clear();
     raise_input_error("seed", "must be an integer in [0, 2**64 - 1]");

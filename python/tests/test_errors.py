@@ -80,6 +80,7 @@ def test_nan_and_inf_are_refused_naming_the_pixel(where):
     ({"threads": 2000}, "threads"),
     ({"seed": -1}, "seed"),
     ({"seed": 2 ** 64}, "seed"),
+    ({"seed": 1.5}, "seed"),
     ({"vote": "median"}, "vote"),
     ({"dtype": np.float64}, "dtype"),
     ({"dtype": "not a dtype"}, "dtype"),

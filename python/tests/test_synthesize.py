@@ -99,3 +99,11 @@ def test_progress_is_called_per_level_and_its_exception_propagates():
 
     with pytest.raises(Stop):
         emaki.synthesize(style, [(src, tgt)], progress=stop)
+
+
+def test_numpy_scalars_are_accepted_as_numbers():
+    style, src, tgt = noise((40, 48, 3), 1), noise((40, 48, 3), 2), noise((36, 44, 3), 3)
+    plain = emaki.synthesize(style, [(src, tgt, 0.5)], seed=3, patch_size=5)
+    same = emaki.synthesize(style, [(src, tgt, np.float32(0.5))], seed=np.uint64(3),
+                            patch_size=np.int64(5))
+    assert np.array_equal(plain, same)
