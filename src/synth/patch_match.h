@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/image.h"
@@ -46,6 +47,9 @@ struct PatchMatchConfig {
   double err_scale = 1.0;
   uint64_t seed = 1;  // already mixed with the level and search-vote iteration
   PatchSsdFn ssd = nullptr;
+  // Called on the calling thread before each sweep, when set; it may throw to stop the run
+  // (cancellation), and otherwise changes nothing.
+  const std::function<void()>* before_sweep = nullptr;
 };
 
 // Patch error of every active target pixel against its current match, in EbSynth units.
