@@ -103,8 +103,12 @@ RuledInputs apply_ebsynth_rules(const NamedPlane& style, const std::vector<Named
       throw Error(g.source.name, fmt::format("source guide is {}x{} but the style '{}' is {}x{}",
                                              plane_width(g.source.plane),
                                              plane_height(g.source.plane), style.name, sw, sh));
-    const int nc = std::max(effective_channels(g.source.plane), effective_channels(g.target.plane));
-    if (nc > 4) throw Error(g.source.name, "a guide must have 1 to 4 channels");
+    const int na = effective_channels(g.source.plane), nb = effective_channels(g.target.plane);
+    const int nc = std::max(na, nb);
+    // Named by the file that has too many, so the user knows which one to fix.
+    if (nc > 4)
+      throw Error(na > 4 ? g.source.name : g.target.name,
+                  fmt::format("a guide must have 1 to 4 channels (has {})", nc));
     GuidePair gp;
     gp.name = g.target.name;
     gp.source_name = g.source.name;

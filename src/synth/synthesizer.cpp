@@ -161,7 +161,7 @@ void validate(const Inputs& in, const Params& p) {
       throw Error(g.name, fmt::format("a guide must have 1 to 4 channels (has {})", cs));
     if (!(g.weight < 0.0f || std::isfinite(g.weight)))
       throw Error(g.name, "weight must be a finite number >= 0");
-    check_finite(g.source, g.name);
+    check_finite(g.source, g.source_name.empty() ? g.name : g.source_name);
     check_finite(g.target, g.name);
   }
   if (sw < p.patch_size || sh < p.patch_size)
