@@ -77,15 +77,6 @@ Raises:
 )";
 
 // A Python error raised in a hook while the GIL was released, carried out of the engine.
-struct PendingError {
-  PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
-  void fetch() { PyErr_Fetch(&type, &value, &trace); }
-  [[noreturn]] void raise() {
-    PyErr_Restore(type, value, trace);
-    throw py::error_already_set();
-  }
-};
-
 // Where the engine read the inputs of this thread's last call (the zero-copy test).
 struct LastCall {
   int64_t layout_copies = 0;

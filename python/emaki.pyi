@@ -123,6 +123,42 @@ def template(
     threads: int = 0,
 ) -> dict[str, npt.NDArray[np.float32]]: ...
 
+class Shot:
+    """A shot file's settings, checked (docs/shot_file.md); the shot API of `emaki run`."""
+    @staticmethod
+    def load(path: str) -> "Shot": ...
+    @staticmethod
+    def from_dict(d: Mapping[str, object], path: str = "shot.toml") -> "Shot": ...
+    @property
+    def path(self) -> str: ...
+    @property
+    def frames(self) -> Tuple[int, int]: ...
+    @property
+    def size(self) -> Tuple[int, int]: ...
+    @property
+    def layers(self) -> list[str]: ...
+    @property
+    def output_folder(self) -> str: ...
+    def run(
+        self,
+        *,
+        frames: Union[None, int, Tuple[int, int]] = None,
+        layers: Optional[Sequence[str]] = None,
+        force: bool = False,
+        previews: bool = True,
+        threads: Optional[int] = None,
+        progress: Optional[Callable[[dict], object]] = None,
+    ) -> dict: ...
+    def composite(
+        self,
+        *,
+        frames: Union[None, int, Tuple[int, int]] = None,
+        previews: bool = True,
+        threads: Optional[int] = None,
+    ) -> int: ...
+    def flicker(self, layer: str, *, frames: Union[None, int, Tuple[int, int]] = None) -> dict: ...
+    def plan(self, *, chunk: int = 8, threads: int = 1, emaki: str = "emaki") -> dict: ...
+
 pass_names: list[str]  # the passes render() and template() return, in channel order
 pass_channels: dict[str, list[str]]  # their EXR channel names: {'normal': ['normal.X', ...], ...}
 

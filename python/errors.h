@@ -38,6 +38,17 @@ struct FieldName {
 // Raises emaki.InputError naming `argument` (for checks the binding makes itself).
 [[noreturn]] void raise_input_error(const std::string& argument, const std::string& message);
 
+// A Python exception raised inside a callback (or a pending Ctrl-C) while C++ ran, kept until
+// the C++ call has unwound and the GIL is back.
+struct PendingError {
+  PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
+  void fetch() { PyErr_Fetch(&type, &value, &trace); }
+  [[noreturn]] void raise() {
+    PyErr_Restore(type, value, trace);
+    throw py::error_already_set();
+  }
+};
+
 // Runs fn(), turning an emaki::Error it throws into the Python exception.
 template <typename Fn>
 auto translating(ErrorKind kind, std::initializer_list<FieldName> fields, Fn&& fn) {

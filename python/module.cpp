@@ -14,6 +14,7 @@ PYBIND11_MODULE(emaki, m) {
       "name, TIFF, JPEG)\n"
       "render()  guide passes of a glTF scene at one frame (as `emaki render`)\n"
       "template()  the reference sphere's passes and paint template (as `emaki template`)\n"
+      "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
       "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
   m.attr("__version__") = "0.1.0";
   // Each docstring starts with its own signature (Python types, as in emaki.pyi) instead of
@@ -24,4 +25,5 @@ PYBIND11_MODULE(emaki, m) {
   bind_synth(m);
   bind_images(m);
   bind_render(m);
+  bind_shot(m);
 }
