@@ -47,7 +47,9 @@ TEST(Schema, KeysAreUniqueAndUnderTheirTables) {
     EXPECT_TRUE(seen.insert(k.key).second) << k.key;
     EXPECT_FALSE(k.meaning.empty()) << k.key;
     EXPECT_EQ(std::isnan(k.lo), std::isnan(k.hi)) << k.key;
-    if (!std::isnan(k.lo)) EXPECT_LE(k.lo, k.hi) << k.key;
+    if (!std::isnan(k.lo)) {
+      EXPECT_LE(k.lo, k.hi) << k.key;
+    }
   }
   EXPECT_EQ(child_keys(""), (std::vector<std::string>{"threads", "limits", "source", "exemplars",
                                                       "layers", "compositing", "outputs"}));
