@@ -1,12 +1,12 @@
-// Temporal noise reduction on the bundled example (examples/fox/shot.toml): one layer run
-// frame by frame, with advection by `position` (the paper's) and by `rest_position`, compared
-// on flicker (`emaki qa flicker`'s measure, split into the walking Fox and the static ground)
-// and, with --judge, on the independent judge's `style` energy of sampled frames (is the
-// output still made of exemplar texture?). Frames stay in memory; nothing is written except
-// the judge's inputs.
+// Temporal noise reduction on a bundled example (examples/fox/shot.toml, or --shot): one layer
+// run frame by frame, with advection by `position` (the paper's) and by `rest_position`,
+// compared on flicker (`emaki qa flicker`'s measure, split into the scene's objects and the
+// static ground, then per object id) and, with --judge, on the independent judge's `style`
+// energy of sampled frames (is the output still made of exemplar texture?). Frames stay in
+// memory; nothing is written except the judge's inputs.
 //
-//   temporal_bench [--size 960x540] [--frames 48] [--layer base] [--variants
-//   frame,position,rest_position]
+//   temporal_bench [--shot SHOT.toml] [--size WxH (the shot's)] [--frames 48] [--layer base]
+//                  [--variants frame,position,rest_position]
 //                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--threads N]
 //
 // The judge is ../shared/tools/judge (build it with its build.sh). Its guides are the layer's
@@ -41,14 +41,16 @@ namespace {
 using namespace emaki;
 
 struct Options {
-  int width = 960, height = 540, frames = 48, threads = 0, judge_every = 8;
+  int width = 0, height = 0, frames = 48, threads = 0, judge_every = 8;  // size 0: the shot's
+  std::string shot = std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml";
   std::string layer = "base", judge, judge_dir = "/tmp/emaki_temporal_judge";
   std::vector<std::string> variants = {"frame", "position", "rest_position"};
 };
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
-               "temporal_bench: %s\nusage: temporal_bench [--size WxH] [--frames N] [--layer NAME] "
+               "temporal_bench: %s\nusage: temporal_bench [--shot SHOT] [--size WxH] [--frames N] "
+               "[--layer NAME] "
                "[--variants a,b,...] [--judge PATH] [--judge-every K] [--judge-dir DIR] "
                "[--threads N]\n",
                why.c_str());
@@ -61,7 +63,9 @@ Options parse(int argc, char** argv) {
     const std::string a = argv[i];
     if (i + 1 >= argc) usage("missing value after " + a);
     const std::string v = argv[++i];
-    if (a == "--size") {
+    if (a == "--shot") {
+      o.shot = v;
+    } else if (a == "--size") {
       if (std::sscanf(v.c_str(), "%dx%d", &o.width, &o.height) != 2) usage("bad --size " + v);
     } else if (a == "--frames") {
       o.frames = std::max(2, std::atoi(v.c_str()));
@@ -119,21 +123,45 @@ double run_judge(const std::string& cmd) {
   return std::stod(m[1]);
 }
 
+// Flicker per object id (rows) and variant (columns), and each variant against the first.
+void print_objects(const pipeline::Shot& shot, const std::vector<std::string>& variants,
+                   const std::vector<pipeline::SequenceFlicker>& flicker) {
+  std::printf("\n%-4s %-24s", "id", "object");
+  for (const std::string& v : variants) std::printf(" %14s", v.c_str());
+  std::printf("\n");
+  for (const auto& [id, first] : flicker[0].by_id) {
+    std::string name = id == 1 ? "ground" : "object";
+    for (std::size_t i = 0; i < shot.source.objects.size(); ++i)
+      if (shot.source.objects[i].id == id)
+        name = fmt::format("objects[{}] {}", i,
+                           std::filesystem::path(shot.source.objects[i].scene).stem().string());
+    std::printf("%-4d %-24s", id, name.c_str());
+    for (const pipeline::SequenceFlicker& f : flicker) {
+      const auto it = f.by_id.find(id);
+      const double m = it == f.by_id.end() ? 0.0 : it->second.mean();
+      std::printf(" %7.5f %5.2fx", m, first.mean() > 0 ? m / first.mean() : 0.0);
+    }
+    std::printf("\n");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Options opt = parse(argc, argv);
   set_thread_count(opt.threads);
   try {
-    pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
-    shot.source.width = shot.source.render.width = opt.width;
-    shot.source.height = shot.source.render.height = opt.height;
+    pipeline::Shot shot = shot::open(opt.shot);
+    if (opt.width > 0) {
+      shot.source.width = shot.source.render.width = opt.width;
+      shot.source.height = shot.source.render.height = opt.height;
+    }
     shot.source.last_frame = shot.source.first_frame + opt.frames - 1;
     shot.source.shot.last_frame = shot.source.last_frame;
     pipeline::Layer* layer = nullptr;
     for (pipeline::Layer& l : shot.layers)
       if (l.name == opt.layer) layer = &l;
-    if (!layer) usage("no layer " + opt.layer + " in the example");
+    if (!layer) usage("no layer " + opt.layer + " in " + opt.shot);
     const auto source = shot::open_frames(shot);
     const auto exemplars = shot::load_exemplars(shot);
     const pipeline::CompositeInputs ci = shot::load_composite_inputs(shot);
@@ -214,9 +242,9 @@ int main(int argc, char** argv) {
     }
 
     std::printf("temporal_bench: layer '%s', %dx%d, frames %d-%d, %d threads%s\n",
-                opt.layer.c_str(), opt.width, opt.height, first, last, thread_count(),
-                judging ? fmt::format(", judge on {} frames", judged).c_str() : "");
-    std::printf("%-14s %9s %10s %10s %10s %12s %12s\n", "variant", "s/frame", "flicker", "fox",
+                opt.layer.c_str(), shot.source.width, shot.source.height, first, last,
+                thread_count(), judging ? fmt::format(", judge on {} frames", judged).c_str() : "");
+    std::printf("%-14s %9s %10s %10s %10s %12s %12s\n", "variant", "s/frame", "flicker", "objects",
                 "ground", "vs frame", "judge style");
     const double base = opt.variants[0] == "frame" ? flicker[0].all.mean() : 0.0;
     const double base_style = opt.variants[0] == "frame" && judged ? style_sum[0] / judged : 0.0;
@@ -233,6 +261,7 @@ int main(int argc, char** argv) {
                        .c_str()
                  : "-");
     }
+    print_objects(shot, opt.variants, flicker);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "temporal_bench: %s\n", e.what());
     return 1;

@@ -110,7 +110,12 @@ void parse_light_and_ground(const Reader& r, scene::ShotSpec& shot) {
 
 void parse_scene_source(const Reader& r, const PathContext& ctx, pipeline::Source& s) {
   s.kind = pipeline::SourceKind::kScene;
-  s.scene_path = ctx.input_file(r, "scene", true);
+  if (r.has("objects")) {
+    for (const char* k : {"clip", "start", "loop"})
+      if (r.has(k)) throw Error(r.key_path(k), "applies to 'scene'; each of 'objects' has its own");
+  } else {
+    s.scene_path = ctx.input_file(r, "scene", true);
+  }
   if (!r.has("size")) throw Error(r.key_path("size"), "is required ([width, height])");
   const std::vector<float> size = r.numbers("size", 2);
   for (float v : size)
@@ -135,7 +140,10 @@ void parse_scene_source(const Reader& r, const PathContext& ctx, pipeline::Sourc
   if (const toml::table* t = r.table("camera")) {
     Reader c(*t, r.key_path("camera"), "source.camera");
     parse_camera(c, s.shot.camera);
+    if (r.has("objects") && s.shot.camera.mode == scene::CameraSpec::Mode::kGltf)
+      throw Error(c.key_path("mode"), "\"gltf\" needs 'scene': objects bring no camera");
   }
+  if (r.has("objects")) parse_objects(r, ctx, s);
   parse_light_and_ground(r, s.shot);
   for (const char* k : {"channels", "preset", "view_layer", "normals", "up", "premultiplied"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'sequence' source only");
@@ -239,7 +247,7 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
   s.z_up = r.choice("up", false, kUpAxes);
   s.premultiplied = r.boolean("premultiplied", false);
   for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera", "light",
-                        "ground", "background", "size"})
+                        "ground", "background", "size", "objects"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");
   parse_channel_mapping(r, s);
   const std::string first = io::frame_file(s.pattern, s.first_frame);
@@ -252,13 +260,14 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
 }  // namespace
 
 void parse_source(const Reader& r, const PathContext& ctx, pipeline::Source& s) {
-  const bool has_scene = r.has("scene"), has_sequence = r.has("sequence");
-  if (has_scene == has_sequence)
-    throw Error(r.path(), has_scene ? "give either 'scene' or 'sequence', not both"
-                                    : "needs 'scene' (a glTF file) or 'sequence' (EXR frames)");
+  const int given = r.has("scene") + r.has("objects") + r.has("sequence");
+  if (given != 1)
+    throw Error(r.path(), given ? "give one of 'scene', 'objects' or 'sequence', not several"
+                                : "needs 'scene' (a glTF file), 'objects' (glTF assets placed in "
+                                  "the shot) or 'sequence' (EXR frames)");
   parse_frames(r, s);
   s.fps = r.real("fps", s.fps);
-  if (has_scene)
+  if (!r.has("sequence"))
     parse_scene_source(r, ctx, s);
   else
     parse_sequence_source(r, ctx, s);
