@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
 """Prints how long two Python threads take to synthesize at once against one alone: the GIL is
 released while the engine runs, so on a machine with two free cores two one-thread syntheses
-take about as long as one (ratio near 1; with the GIL held it would be 2). Also printed: the
-process's CPU seconds per wall second while the two run (each call uses one engine thread, so
-with the GIL held it could not exceed 1.0; on a machine busy with other jobs this is the figure
-that still shows the two running at once).
+take about as long as one (ratio near 1; with the GIL held it would be 2).
+
+Also printed, for a machine busy with other jobs (where the ratio says little): the process's
+CPU seconds per wall second while the two run (each call uses one engine thread, so with the
+GIL held it would stay at or below 1.0), and how often the two calls' pyramid levels alternate
+(the engine reports each level as it starts; with the GIL held for a whole call, one call's
+levels would all come before the other's: 1 switch).
 
     PYTHONPATH=build/release/python /usr/bin/python3 bench/python_gil.py [REPEATS]
 """
@@ -35,16 +38,19 @@ def main():
     guides = [(half(emaki.read_image(STYLIT / ("source_%s.png" % g))),
                half(emaki.read_image(STYLIT / ("target_%s.png" % g))), 0.5) for g in GUIDES]
 
-    def one():
-        emaki.synthesize(style, guides, threads=1)
+    def one(events=None, tag=0):
+        progress = None if events is None else (
+            lambda level, levels: events.append((time.perf_counter(), tag, level)))
+        emaki.synthesize(style, guides, threads=1, progress=progress)
 
     one()  # warm up
-    alone, both, parallelism = [], [], []
+    alone, both, parallelism, mixed = [], [], [], []
     for _ in range(repeats):
         start = time.perf_counter()
         one()
         alone.append(time.perf_counter() - start)
-        threads = [threading.Thread(target=one) for _ in range(2)]
+        events = []
+        threads = [threading.Thread(target=one, args=(events, k)) for k in range(2)]
         start, cpu = time.perf_counter(), time.process_time()
         for t in threads:
             t.start()
@@ -52,8 +58,12 @@ def main():
             t.join()
         both.append(time.perf_counter() - start)
         parallelism.append((time.process_time() - cpu) / both[-1])
-        print("one alone %.3f s, two at once %.3f s (%.2f CPU s per s)"
-              % (alone[-1], both[-1], parallelism[-1]), flush=True)
+        # Pyramid levels start inside the engine: with the GIL held for a whole call, one
+        # call's levels would all come before the other's.
+        order = [tag for _, tag, _ in sorted(events)]
+        mixed.append(sum(a != b for a, b in zip(order, order[1:])))
+        print("one alone %.3f s, two at once %.3f s (%.2f CPU s per s, level starts alternate "
+              "%d times)" % (alone[-1], both[-1], parallelism[-1], mixed[-1]), flush=True)
     a, b = statistics.median(alone), statistics.median(both)
     print("StyLit 600x456, threads=1 per call, %d repeats:" % repeats)
     print("  one synthesis alone      median %.3f s" % a)
@@ -64,6 +74,8 @@ def main():
     print("  (1.0: the two run in parallel; 2.0: serialised, as with the GIL held)")
     print("  CPU seconds per wall second with two at once: median %.2f (max %.2f; <= 1.0 if "
           "serialised)" % (statistics.median(parallelism), max(parallelism)))
+    print("  the two calls' pyramid levels interleave: %d switches per run (median; 1 if the GIL "
+          "serialised the calls)" % statistics.median(mixed))
 
 
 if __name__ == "__main__":

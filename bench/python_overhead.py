@@ -12,6 +12,13 @@ when other jobs share the cores.
 
 THREADS (default 0: all cores) goes to both; 1 makes each run less sensitive to other jobs on a
 shared machine.
+
+    ... bench/python_overhead.py --instructions
+
+counts instead the instructions each executes (valgrind's callgrind, one thread, StyLit at
+half size), which no other job can disturb: the engine's own functions (rules, Synthesizer)
+in each, and the whole synthesis region in each (the CLI: from the decoded files to B'; Python:
+the whole emaki.synthesize call, arrays in and out).
 """
 
 import os
@@ -42,7 +49,61 @@ def cli_seconds(out, threads):
     return float(m.group(1)), float(m.group(2))
 
 
+ENGINE = ["emaki::synth::apply_ebsynth_rules*", "emaki::synth::Synthesizer::Synthesizer*",
+          "emaki::synth::RuledInputs::release_guides*", "emaki::synth::Synthesizer::run*"]
+CLI_REGION = ["emaki::app::(anonymous namespace)::ruled_inputs*"] + ENGINE[1:]
+PY_REGION = ["emaki::python::(anonymous namespace)::synthesize*"]
+PY_CALL = """
+import emaki
+s = emaki.read_image('source_style.png')
+g = [(emaki.read_image('source_%s.png' % n), emaki.read_image('target_%s.png' % n), 0.5)
+     for n in ('fullgi', 'dirdif', 'dirspc', 'indirb')]
+emaki.write_image('py.png', emaki.synthesize(s, g, threads=1))
+"""
+
+
+def callgrind(folder, functions, command):
+    """Instructions executed inside `functions` (callgrind's --toggle-collect)."""
+    toggles = ["--toggle-collect=%s" % f for f in functions]
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.abspath(emaki.__file__)))
+    proc = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                           "--collect-atstart=no", *toggles, *command], cwd=folder, env=env,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return int(re.search(r"Collected : (\d+)", proc.stderr).group(1))
+
+
+def instructions():
+    import numpy as np
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in ["source_style"] + ["%s_%s" % (s, g) for g in GUIDES for s in ("source", "target")]:
+            a = emaki.read_image(STYLIT / (name + ".png"))
+            h, w, c = a.shape
+            m = a.reshape(h // 2, 2, w // 2, 2, c).astype(np.float64).mean(axis=(1, 3))
+            emaki.write_image(pathlib.Path(tmp) / (name + ".png"), np.floor(m + 0.5).astype(np.uint8))
+        cli = [BINARY, "synth", "-style", "source_style.png", "-output", "cli.png", "--threads", "1"]
+        for g in GUIDES:
+            cli += ["-guide", "source_%s.png" % g, "target_%s.png" % g, "-weight", "0.5"]
+        py = [sys.executable, "-c", PY_CALL]
+        figures = [(label, callgrind(tmp, ENGINE if "engine" in label else region, cmd))
+                   for label, region, cmd in [
+                       ("emaki synth, engine", None, cli), ("emaki.synthesize, engine", None, py),
+                       ("emaki synth, synthesis region", CLI_REGION, cli),
+                       ("emaki.synthesize, whole call", PY_REGION, py)]]
+        same = (emaki.read_image(pathlib.Path(tmp) / "cli.png") ==
+                emaki.read_image(pathlib.Path(tmp) / "py.png")).all()
+    print("StyLit 600x456, 4 guides, one thread, instructions (callgrind):")
+    for label, n in figures:
+        print("  %-32s %15d" % (label, n))
+    print("  engine: %+.3f %%; whole call against the CLI's synthesis: %+.3f %%; same pixels: %s"
+          % (100 * (figures[1][1] / figures[0][1] - 1), 100 * (figures[3][1] / figures[2][1] - 1),
+             same))
+
+
 def main():
+    if sys.argv[1:2] == ["--instructions"]:
+        instructions()
+        return
     runs = int(sys.argv[1]) if len(sys.argv) > 1 else 5
     threads = int(sys.argv[2]) if len(sys.argv) > 2 else 0
     style = emaki.read_image(STYLIT / "source_style.png")

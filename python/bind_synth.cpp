@@ -162,10 +162,12 @@ synth::Result run_engine(const ArrayPlane& style, const std::vector<GuideArrays>
   if (!progress.is_none())
     params.progress = [&pending, &progress](int level, int levels) {
       py::gil_scoped_acquire gil;
-      if (PyObject_CallFunction(progress.ptr(), "ii", level, levels) == nullptr) {
+      PyObject* returned = PyObject_CallFunction(progress.ptr(), "ii", level, levels);
+      if (returned == nullptr) {
         pending.fetch();
         throw synth::Cancelled();
       }
+      Py_DECREF(returned);
     };
   std::vector<synth::NamedGuide> named;
   for (std::size_t k = 0; k < guides.size(); ++k)

@@ -1,5 +1,7 @@
 """emaki.synthesize against `emaki synth` on the same data, bit for bit, and its options."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -89,6 +91,10 @@ def test_progress_is_called_per_level_and_its_exception_propagates():
     emaki.synthesize(style, [(src, tgt)], progress=lambda level, levels: calls.append((level, levels)))
     assert calls and calls[0][0] == 0 and all(n == calls[0][1] for _, n in calls)
     assert [l for l, _ in calls] == list(range(calls[0][1]))
+    returned = object()
+    count = sys.getrefcount(returned)
+    emaki.synthesize(style, [(src, tgt)], progress=lambda level, levels: returned)
+    assert sys.getrefcount(returned) == count  # what progress returns is not kept
 
     class Stop(Exception):
         pass
