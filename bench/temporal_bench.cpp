@@ -145,6 +145,72 @@ void print_objects(const pipeline::Shot& shot, const std::vector<std::string>& v
   }
 }
 
+// The judge's style energy of every variant's frame f, added to style_sum.
+void judge_frame(const Options& opt, const pipeline::Layer& l, int f, const Image<float>& passes,
+                 const std::vector<bench::MemoryStore>& stores, const std::string& judge_fixed,
+                 std::vector<double>& style_sum) {
+  const int value_channels = l.single_colour ? 1 : 3;
+  std::string guides;
+  for (const pipeline::GuideSpec& g : l.guides) {
+    const std::string tgt = fmt::format("{}/target_{}_{:04d}.png", opt.judge_dir, g.pass, f);
+    write_png(tgt, judge_guide(pipeline::extract_pass(passes.cview(), g.pass), g.pass));
+    guides += fmt::format(" -guide '{}/source_{}.png' '{}' -weight {}", opt.judge_dir, g.pass, tgt,
+                          g.weight);
+  }
+  for (std::size_t v = 0; v < opt.variants.size(); ++v) {
+    const Image<float> cur = stores[v].read_layer(l, f);
+    Image<float> out(cur.width(), cur.height(), value_channels);
+    for (int y = 0; y < cur.height(); ++y)
+      for (int x = 0; x < cur.width(); ++x) {
+        const float a = cur.channels() > value_channels ? cur(x, y, value_channels) : 1.0f;
+        for (int c = 0; c < value_channels; ++c) out(x, y, c) = a * cur(x, y, c) + (1.0f - a);
+      }
+    const std::string path = fmt::format("{}/{}_{:04d}.png", opt.judge_dir, opt.variants[v], f);
+    write_png(path, out);
+    const double s = run_judge(judge_fixed + guides + fmt::format(" -output-to-judge '{}'", path));
+    std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f\n", f,
+                 opt.variants[v].c_str(), s);
+    style_sum[v] += s;
+  }
+}
+
+// The judge's inputs that do not change (the touch and the exemplar's guides), written once;
+// returns the start of its command line.
+std::string judge_inputs(const Options& opt, const pipeline::Layer& layer,
+                         const pipeline::ExemplarImages& ex) {
+  std::filesystem::create_directories(opt.judge_dir);
+  const std::string style = opt.judge_dir + "/style.png";
+  write_png(style, layer.single_colour ? composite::touch(ex.painting.cview(), layer.channel)
+                                       : pipeline::extract(ex.painting.cview(), 0, 3));
+  for (const pipeline::GuideSpec& g : layer.guides)
+    write_png(fmt::format("{}/source_{}.png", opt.judge_dir, g.pass),
+              judge_guide(pipeline::extract_pass(ex.passes.cview(), g.pass), g.pass));
+  return fmt::format("'{}' -style '{}'", opt.judge, style);
+}
+
+// Each variant of the layer run into its own store (frame by frame, position, rest_position).
+std::vector<bench::MemoryStore> run_variants(
+    std::vector<double>& seconds, const Options& opt, const pipeline::Shot& shot,
+    pipeline::Layer& layer, const pipeline::FrameSource& source,
+    const std::map<std::string, pipeline::ExemplarImages>& exemplars,
+    const pipeline::CompositeInputs& ci) {
+  std::vector<bench::MemoryStore> stores(opt.variants.size());
+  seconds.assign(opt.variants.size(), 0.0);
+  for (std::size_t v = 0; v < opt.variants.size(); ++v) {
+    const std::string& name = opt.variants[v];
+    layer.temporal.enabled = name != "frame";
+    layer.temporal.guide = name == "position" ? pipeline::AdvectionGuide::kPosition
+                                              : pipeline::AdvectionGuide::kRestPosition;
+    pipeline::RunOptions o;
+    o.layers = {opt.layer};
+    const auto t0 = std::chrono::steady_clock::now();
+    pipeline::run_shot(shot, source, exemplars, ci, stores[v], o);
+    seconds[v] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::fprintf(stderr, "temporal_bench: %s done in %.1f s\n", name.c_str(), seconds[v]);
+  }
+  return stores;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -168,35 +234,13 @@ int main(int argc, char** argv) {
     const int first = shot.source.first_frame, last = shot.source.last_frame;
     const int value_channels = layer->single_colour ? 1 : 3;
 
-    std::vector<bench::MemoryStore> stores(opt.variants.size());
-    std::vector<double> seconds(opt.variants.size());
-    for (std::size_t v = 0; v < opt.variants.size(); ++v) {
-      const std::string& name = opt.variants[v];
-      layer->temporal.enabled = name != "frame";
-      layer->temporal.guide = name == "position" ? pipeline::AdvectionGuide::kPosition
-                                                 : pipeline::AdvectionGuide::kRestPosition;
-      pipeline::RunOptions o;
-      o.layers = {opt.layer};
-      const auto t0 = std::chrono::steady_clock::now();
-      pipeline::run_shot(shot, *source, exemplars, ci, stores[v], o);
-      seconds[v] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::fprintf(stderr, "temporal_bench: %s done in %.1f s\n", name.c_str(), seconds[v]);
-    }
+    std::vector<double> seconds;
+    std::vector<bench::MemoryStore> stores =
+        run_variants(seconds, opt, shot, *layer, *source, exemplars, ci);
 
-    // Judge inputs that do not change: the touch and the exemplar's guides.
     const bool judging = !opt.judge.empty();
-    std::string judge_fixed;
-    if (judging) {
-      std::filesystem::create_directories(opt.judge_dir);
-      const pipeline::ExemplarImages& ex = exemplars.at(layer->exemplar);
-      const std::string style = opt.judge_dir + "/style.png";
-      write_png(style, layer->single_colour ? composite::touch(ex.painting.cview(), layer->channel)
-                                            : pipeline::extract(ex.painting.cview(), 0, 3));
-      judge_fixed = fmt::format("'{}' -style '{}'", opt.judge, style);
-      for (const pipeline::GuideSpec& g : layer->guides)
-        write_png(fmt::format("{}/source_{}.png", opt.judge_dir, g.pass),
-                  judge_guide(pipeline::extract_pass(ex.passes.cview(), g.pass), g.pass));
-    }
+    const std::string judge_fixed =
+        judging ? judge_inputs(opt, *layer, exemplars.at(layer->exemplar)) : std::string();
 
     std::vector<pipeline::SequenceFlicker> flicker(opt.variants.size());
     std::vector<double> style_sum(opt.variants.size(), 0.0);
@@ -212,30 +256,7 @@ int main(int argc, char** argv) {
                                                prev_passes.cview(), mask_channel));
       }
       if (judging && (f - first) % opt.judge_every == opt.judge_every / 2) {
-        std::string guides;
-        for (const pipeline::GuideSpec& g : l.guides) {
-          const std::string tgt = fmt::format("{}/target_{}_{:04d}.png", opt.judge_dir, g.pass, f);
-          write_png(tgt, judge_guide(pipeline::extract_pass(passes.cview(), g.pass), g.pass));
-          guides += fmt::format(" -guide '{}/source_{}.png' '{}' -weight {}", opt.judge_dir, g.pass,
-                                tgt, g.weight);
-        }
-        for (std::size_t v = 0; v < opt.variants.size(); ++v) {
-          const Image<float> cur = stores[v].read_layer(l, f);
-          Image<float> out(cur.width(), cur.height(), value_channels);
-          for (int y = 0; y < cur.height(); ++y)
-            for (int x = 0; x < cur.width(); ++x) {
-              const float a = cur.channels() > value_channels ? cur(x, y, value_channels) : 1.0f;
-              for (int c = 0; c < value_channels; ++c) out(x, y, c) = a * cur(x, y, c) + (1.0f - a);
-            }
-          const std::string path =
-              fmt::format("{}/{}_{:04d}.png", opt.judge_dir, opt.variants[v], f);
-          write_png(path, out);
-          const double s =
-              run_judge(judge_fixed + guides + fmt::format(" -output-to-judge '{}'", path));
-          std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f\n", f,
-                       opt.variants[v].c_str(), s);
-          style_sum[v] += s;
-        }
+        judge_frame(opt, *layer, f, passes, stores, judge_fixed, style_sum);
         ++judged;
       }
       prev_passes = std::move(passes);
