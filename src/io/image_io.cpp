@@ -40,18 +40,6 @@ PixelType AnyImage::type() const {
                               : PixelType::kF32;
 }
 
-namespace {
-template <typename T>
-float normalised(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>)
-    return v * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>)
-    return v * (1.0f / 65535.0f);
-  else
-    return v;
-}
-}  // namespace
-
 float AnyImage::value(int x, int y, int c) const {
   return std::visit([&](const auto& im) { return normalised(im(x, y, c)); }, image);
 }

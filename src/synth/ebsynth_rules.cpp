@@ -11,18 +11,6 @@
 namespace emaki::synth {
 namespace {
 
-// Samples normalised as the image readers do (io::AnyImage::value), so that "opaque" means the
-// same whichever front end loaded the image.
-template <typename T>
-float normalised(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>)
-    return v * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>)
-    return v * (1.0f / 65535.0f);
-  else
-    return v;
-}
-
 template <typename T>
 int effective_channels(const ImageView<const T>& v) {
   const int nc = v.channels, w = v.width, h = v.height;
