@@ -69,16 +69,6 @@ void view_or_copy(ArrayPlane& a, int w, int h, int c) {
   g_input_copies.fetch_add(1, std::memory_order_relaxed);
 }
 
-template <typename T>
-float normalised(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>)
-    return v * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>)
-    return v * (1.0f / 65535.0f);
-  else
-    return v;
-}
-
 }  // namespace
 
 const void* ArrayPlane::data() const {
