@@ -44,7 +44,7 @@ int find_clip(const scene::Scene& asset, const pipeline::SceneObject& o, std::si
     for (std::size_t k = 0; k < asset.animations.size() && k < 16; ++k)
       names += (k ? ", '" : "'") + echo(asset.animations[k].name, 40) + "'";
     throw Error(key_of(i, "clip"), fmt::format("no clip '{}' in '{}' (clips: {})", echo(o.clip),
-                                               echo(o.scene), names.empty() ? "none" : names));
+                                               echo_path(o.scene), names.empty() ? "none" : names));
   }
   const scene::Animation& a = asset.animations[clip];
   const double length = double(a.end) - a.start;

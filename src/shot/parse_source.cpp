@@ -28,16 +28,16 @@ void check_pattern(const std::string& key, const std::string& pattern) {
       width = width * 10 + (pattern[j++] - '0');
       if (width > io::kMaxFrameWidth)
         throw Error(key, fmt::format("'{}': the frame number's width must be at most {}",
-                                     echo(pattern), io::kMaxFrameWidth));
+                                     echo_path(pattern), io::kMaxFrameWidth));
     }
     if (j >= pattern.size() || pattern[j] != 'd')
-      throw Error(key, fmt::format("'{}': only %d or %0Nd may follow '%'", echo(pattern)));
+      throw Error(key, fmt::format("'{}': only %d or %0Nd may follow '%'", echo_path(pattern)));
     ++count;
     i = j;
   }
   if (count != 1)
-    throw Error(key,
-                fmt::format("'{}' must contain exactly one frame number (%04d)", echo(pattern)));
+    throw Error(
+        key, fmt::format("'{}' must contain exactly one frame number (%04d)", echo_path(pattern)));
 }
 
 // source.frames: checked as int64 before narrowing, so 4294967297 cannot quietly become 1.
@@ -183,7 +183,7 @@ void parse_channel_mapping(const Reader& r, pipeline::Source& s) {
     list += (i ? ", " : "") + echo(have[i], 40);
   if (have.size() > 64) list += fmt::format(", ... ({} more)", have.size() - 64);
   throw Error(key, fmt::format("channel '{}' ({}) is not in '{}', which has: {}", echo(ch), what,
-                               echo(first), list.empty() ? "no channels" : list));
+                               echo_path(first), list.empty() ? "no channels" : list));
 }
 
 // The first frame must exist and carry every pass the pipeline may read; it gives the size.
@@ -192,7 +192,7 @@ std::string check_first_frame(const Reader& r, pipeline::Source& s, const std::s
   std::error_code ec;
   if (!fs::is_regular_file(first, ec))
     throw Error(r.key_path("sequence"),
-                fmt::format("no such file '{}' (frame {})", echo(first), s.first_frame));
+                fmt::format("no such file '{}' (frame {})", echo_path(first), s.first_frame));
   const std::vector<std::string> have = io::list_channels(first);
   auto has = [&](const std::string& ch) {
     return std::find(have.begin(), have.end(), ch) != have.end();

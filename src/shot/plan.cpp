@@ -205,8 +205,8 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
     const std::string folder = fs::weakly_canonical(s.shot.outputs.folder).string();
     if (const auto it = folders.find(folder); it != folders.end())
       throw Error(Error::Field{"shots"},
-                  fmt::format("'{}' and '{}' write the same output folder '{}'", echo(it->second),
-                              echo(s.path), echo(folder)));
+                  fmt::format("'{}' and '{}' write the same output folder '{}'",
+                              echo_path(it->second), echo_path(s.path), echo_path(folder)));
     folders[folder] = s.path;
     if (s.name.empty()) s.name = fs::path(s.path).stem().string();
     if (const int n = names[s.name]++; n > 0) s.name += fmt::format("-{}", n + 1);
