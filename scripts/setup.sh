@@ -5,6 +5,7 @@ set -e
 PKGS="build-essential cmake pkg-config libopenimageio-dev openimageio-tools libopencv-core-dev
 libopenexr-dev libtinygltf-dev libtbb-dev libcli11-dev libtomlplusplus-dev libfmt-dev
 libglm-dev libgtest-dev libgmock-dev libbenchmark-dev libpng-dev ffmpeg blender python3-numpy
+pybind11-dev python3-dev python3-pytest
 clang-14 libclang-rt-14-dev clang-format slurm-wlm slurm-client munge"
 missing=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done

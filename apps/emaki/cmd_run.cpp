@@ -2,7 +2,10 @@
 // previews — resuming after the last finished frame. `emaki composite SHOT` re-colours finished
 // layers without synthesizing. `emaki qa flicker|ghost SHOT --layer NAME` measures temporal
 // error and ghosts.
+#include <fmt/format.h>
+
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -12,6 +15,45 @@
 #include "shot/shot.h"
 
 namespace emaki::app {
+
+namespace {
+
+// What an id of the object_id pass is in the shot: the ground, one of source.objects, or a
+// mesh of the scene file.
+std::string object_label(const pipeline::Shot& shot, int id) {
+  if (id == 1) return "ground";
+  const std::vector<pipeline::SceneObject>& objects = shot.source.objects;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    if (objects[i].id == id)
+      return fmt::format("objects[{}] {}", i,
+                         std::filesystem::path(objects[i].scene).filename().string());
+  return "object";
+}
+
+void print_flicker(const pipeline::Shot& shot, const std::string& layer,
+                   const shot::FlickerResult& r) {
+  std::printf("%-6s %12s %12s %12s %9s\n", "frame", "all", "objects", "ground", "pixels");
+  for (const pipeline::FrameFlicker& f : r.frames)
+    std::printf("%-6d %12.5f %12.5f %12.5f %9ld\n", f.frame, f.all.mean(), f.objects.mean(),
+                f.ground.mean(), f.all.pixels);
+  const pipeline::SequenceFlicker& m = r.mean;
+  std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", m.all.mean(), m.objects.mean(),
+              m.ground.mean());
+  // Per object id, over the frames in which the object was measured.
+  std::printf("\n%-6s %-32s %12s %7s\n", "id", "object", "flicker", "frames");
+  std::string by_id;
+  for (const auto& [id, s] : m.by_id) {
+    std::printf("%-6d %-32s %12.5f %7ld\n", id, object_label(shot, id).c_str(), s.mean(), s.pixels);
+    by_id += fmt::format("{}\"{}\": {:.6f}", by_id.empty() ? "" : ", ", id, s.mean());
+  }
+  std::printf(
+      "{\"layer\": \"%s\", \"frames\": [%d, %d], \"mean\": %.6f, \"objects\": %.6f, "
+      "\"ground\": %.6f, \"by_id\": {%s}}\n",
+      layer.c_str(), r.first_frame, r.last_frame, m.all.mean(), m.objects.mean(), m.ground.mean(),
+      by_id.c_str());
+}
+
+}  // namespace
 
 int run_run(const Args& args) {
   CLI::App app{
@@ -65,7 +107,7 @@ int run_qa_flicker(const Args& args) {
   CLI::App app{
       "Temporal error of a layer's frames: mean |B'(t) - B'(t-1)| sampled along the "
       "renderer's motion vectors over pixels visible in both frames, split into scene "
-      "objects and ground. Prints a table and a JSON line.",
+      "objects and ground, and per object id. Prints tables and a JSON line.",
       "emaki qa flicker"};
   ShotCommand c;
   std::string layer;
@@ -75,18 +117,7 @@ int run_qa_flicker(const Args& args) {
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request request = c.request("qa");
   request.progress = nullptr;
-  const shot::FlickerResult r = shot::flicker(shot, layer, request);
-  std::printf("%-6s %12s %12s %12s %9s\n", "frame", "all", "objects", "ground", "pixels");
-  for (const pipeline::FrameFlicker& f : r.frames)
-    std::printf("%-6d %12.5f %12.5f %12.5f %9ld\n", f.frame, f.all.mean(), f.objects.mean(),
-                f.ground.mean(), f.all.pixels);
-  const pipeline::SequenceFlicker& m = r.mean;
-  std::printf("%-6s %12.5f %12.5f %12.5f\n", "mean", m.all.mean(), m.objects.mean(),
-              m.ground.mean());
-  std::printf(
-      "{\"layer\": \"%s\", \"frames\": [%d, %d], \"mean\": %.6f, \"objects\": %.6f, "
-      "\"ground\": %.6f}\n",
-      layer.c_str(), r.first_frame, r.last_frame, m.all.mean(), m.objects.mean(), m.ground.mean());
+  print_flicker(shot, layer, shot::flicker(shot, layer, request));
   return 0;
 }
 

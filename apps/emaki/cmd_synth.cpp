@@ -1,18 +1,23 @@
 // `emaki synth`: guided synthesis from files. Accepts EbSynth's command line unchanged (single-
 // dash options, `-weight` applying to the -style or -guide before it), so scripts that call
 // `ebsynth` switch by changing the program name; adds long options of its own.
-#include <array>
+#include <fmt/format.h>
+
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <exception>
+#include <filesystem>
+#include <optional>
 #include <string>
-#include <vector>
 
 #include "apps/emaki/commands.h"
 #include "apps/emaki/synth_args.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
+#include "synth/ebsynth_rules.h"
 #include "synth/synthesizer.h"
 
 namespace emaki::app {
@@ -63,10 +68,6 @@ synth::Plane plane_of(const io::AnyImage& im) {
   return std::visit([](const auto& i) -> synth::Plane { return i.view(); }, im.image);
 }
 
-// ---------------------------------------------------------------------------------------------
-// Parse: the command line (synth_args.cpp), then every output path, so that an unwritable one
-// fails before any long work.
-
 void check_output_path(const std::string& opt, const std::string& path) {
   try {
     io::check_writable(path);
@@ -75,27 +76,16 @@ void check_output_path(const std::string& opt, const std::string& path) {
   }
 }
 
-void check_output_paths(const SynthArgs& args) {
-  check_output_path("-output", args.output);
-  if (!args.nnf_out.empty()) check_output_path("--nnf-out", args.nnf_out);
-  if (!args.error_out.empty()) check_output_path("--error-out", args.error_out);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Load: the files, with the channels EbSynth's rules give them. Sizes, channel counts and
-// values are the engine's to check (synth::validate), naming the file each came from.
-
-struct SynthFiles {
-  SynthChannels channels;  // what EbSynth's rules made of the files
-  io::AnyImage style;
-  std::vector<io::AnyImage> guides;       // source, target, source, target, ... in -guide order
-  std::vector<io::AnyImage> weight_maps;  // per -guide; empty without --guide-weight-map
-  io::AnyImage mask;                      // empty without --mask
-};
-
-// Decodes every file at once (PNG decoding is serial per file); reports the first failure in
-// command-line order so the error does not depend on timing.
-std::vector<io::AnyImage> read_images(const std::vector<std::string>& paths) {
+// The decoded files: style, then each guide's source and target, then the mask if any, then
+// each guide's weight map (--guide-weight-map) in -guide order.
+// PNG decoding is serial per file, so the files are decoded at once; the first failure is
+// reported in command-line order so that the error does not depend on timing.
+std::vector<io::AnyImage> read_files(const SynthArgs& args) {
+  std::vector<std::string> paths{args.style_path};
+  for (const auto& g : args.guides) paths.insert(paths.end(), {g.source, g.target});
+  if (!args.mask_path.empty()) paths.push_back(args.mask_path);
+  for (const auto& g : args.guides)
+    if (!g.weight_map.empty()) paths.push_back(g.weight_map);
   std::vector<io::AnyImage> files(paths.size());
   std::vector<std::exception_ptr> failures(paths.size());
   parallel_for(int64_t(paths.size()), 1, [&](int64_t a, int64_t b) {
@@ -112,81 +102,28 @@ std::vector<io::AnyImage> read_images(const std::vector<std::string>& paths) {
   return files;
 }
 
-SynthFiles load_files(const SynthArgs& args) {
-  std::vector<std::string> paths{args.style_path}, map_paths;
-  for (const SynthGuideArg& g : args.guides) {
-    paths.insert(paths.end(), {g.source, g.target});
-    if (!g.weight_map.empty()) map_paths.push_back(g.weight_map);
-  }
-  const std::size_t guide_files = paths.size();
-  paths.insert(paths.end(), map_paths.begin(), map_paths.end());
-  std::vector<io::AnyImage> files = read_images(paths);
-  std::vector<io::AnyImage> maps(std::make_move_iterator(files.begin() + guide_files),
-                                 std::make_move_iterator(files.end()));
-  files.resize(guide_files);
-  std::vector<std::array<int, 2>> guide_channels;
-  for (std::size_t k = 1; k < files.size(); k += 2)
-    guide_channels.push_back({effective_channels(files[k]), effective_channels(files[k + 1])});
-
-  SynthFiles r;
-  r.channels = resolve_channels(args, effective_channels(files[0]), guide_channels);
-  r.style = with_channels(std::move(files[0]), r.channels.style_channels);
-  for (std::size_t k = 1; k < files.size(); ++k)
-    r.guides.push_back(with_channels(std::move(files[k]), r.channels.guides[(k - 1) / 2].channels));
-  for (std::size_t k = 0, m = 0; k < args.guides.size(); ++k)
-    r.weight_maps.push_back(args.guides[k].weight_map.empty() ? io::AnyImage()
-                                                              : std::move(maps[m++]));
-  if (!args.mask_path.empty()) r.mask = io::read_image(args.mask_path);
-  return r;
-}
-
-// The engine's view of the files, with the names its errors give.
-synth::Inputs engine_inputs(const SynthArgs& args, const SynthFiles& files) {
-  synth::Inputs in;
-  in.style = plane_of(files.style);
-  in.style_name = args.style_path;
+// EbSynth's rules (synth/ebsynth_rules.h) over the decoded files, named by their paths.
+synth::RuledInputs ruled_inputs(const SynthArgs& args, const std::vector<io::AnyImage>& files) {
+  std::vector<synth::NamedGuide> guides;
   for (std::size_t k = 0; k < args.guides.size(); ++k) {
-    synth::GuidePair gp;
-    gp.name = args.guides[k].target;
-    gp.source_name = args.guides[k].source;
-    gp.source = plane_of(files.guides[2 * k]);
-    gp.target = plane_of(files.guides[2 * k + 1]);
-    gp.weight = files.channels.guides[k].weight;
-    if (!args.guides[k].weight_map.empty()) {
-      gp.weight_map = plane_of(files.weight_maps[k]);
-      gp.weight_map_name = args.guides[k].weight_map;
-    }
-    in.guides.push_back(gp);
+    const SynthGuideArg& g = args.guides[k];
+    guides.push_back(
+        {{plane_of(files[1 + 2 * k]), g.source}, {plane_of(files[2 + 2 * k]), g.target}, g.weight});
   }
-  if (!args.mask_path.empty()) {
-    in.target_mask = plane_of(files.mask);
-    in.target_mask_name = args.mask_path;
+  std::size_t next = 1 + 2 * args.guides.size();
+  std::optional<synth::NamedPlane> mask;
+  if (!args.mask_path.empty()) mask = synth::NamedPlane{plane_of(files[next++]), args.mask_path};
+  synth::RuledInputs ruled =
+      synth::apply_ebsynth_rules({plane_of(files[0]), args.style_path}, guides, mask);
+  // Weight maps are read as they are (first channel), after the rules.
+  for (std::size_t k = 0; k < args.guides.size(); ++k) {
+    if (args.guides[k].weight_map.empty()) continue;
+    ruled.inputs.guides[k].weight_map = plane_of(files[next++]);
+    ruled.inputs.guides[k].weight_map_name = args.guides[k].weight_map;
   }
-  return in;
+  return ruled;
 }
 
-// ---------------------------------------------------------------------------------------------
-// Run
-
-synth::Result run_engine(const SynthArgs& args, SynthFiles& files) {
-  synth::Inputs in = engine_inputs(args, files);
-  synth::Params params = args.params;
-  params.style_weight = files.channels.style_weight;
-  synth::OutputRequest req;
-  req.nnf = !args.nnf_out.empty();
-  req.error = !args.error_out.empty();
-  synth::Synthesizer synthesizer(in, params);
-  // The guides are packed into the engine's features now; free them before the long part.
-  in.guides.clear();
-  files.guides.clear();
-  files.guides.shrink_to_fit();
-  return synthesizer.run(req);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Write
-
-// --output-depth, else the style file's sample type.
 io::SampleFormat output_format(const std::string& depth, io::PixelType style_type) {
   if (depth == "8") return io::SampleFormat::kU8;
   if (depth == "16") return io::SampleFormat::kU16;
@@ -196,45 +133,23 @@ io::SampleFormat output_format(const std::string& depth, io::PixelType style_typ
   return io::SampleFormat::kFloat;
 }
 
-// A one-channel style comes out as RGB (plus alpha with a mask), as EbSynth writes it.
-Image<float> as_written(Image<float> image, int style_channels) {
-  if (style_channels != 1 || image.channels() > 2) return image;
-  const bool alpha = image.channels() == 2;
-  Image<float> rgb(image.width(), image.height(), alpha ? 4 : 3);
-  for (int y = 0; y < image.height(); ++y)
-    for (int x = 0; x < image.width(); ++x) {
-      for (int c = 0; c < 3; ++c) rgb(x, y, c) = image(x, y, 0);
-      if (alpha) rgb(x, y, 3) = image(x, y, 1);
-    }
-  return rgb;
-}
-
-void write_nnf(const std::string& path, const Image<int32_t>& nnf) {
-  Image<float> f(nnf.width(), nnf.height(), 2);
-  for (int y = 0; y < f.height(); ++y)
-    for (int x = 0; x < f.width(); ++x)
-      for (int c = 0; c < 2; ++c) f(x, y, c) = float(nnf(x, y, c));
-  io::WriteOptions o;
-  o.format = io::SampleFormat::kFloat;
-  o.channel_names = {"nnf.X", "nnf.Y"};
-  io::write_image(path, f.cview(), o);
-}
-
-void write_error(const std::string& path, const Image<float>& error) {
-  io::WriteOptions o;
-  o.format = io::SampleFormat::kFloat;
-  o.channel_names = {"error.Y"};
-  io::write_image(path, error.cview(), o);
-}
-
-// B' as EbSynth writes it, and the extras asked for.
-void write_outputs(const SynthArgs& args, const SynthFiles& files, synth::Result& res) {
-  io::WriteOptions wo;
-  wo.format = output_format(args.depth, files.style.type());
-  const Image<float> out = as_written(std::move(res.image), files.channels.style_channels);
-  io::write_image(args.output, out.cview(), wo);
-  if (!args.nnf_out.empty()) write_nnf(args.nnf_out, res.nnf);
-  if (!args.error_out.empty()) write_error(args.error_out, res.error);
+void write_field_and_error(const SynthArgs& args, const synth::Result& res) {
+  if (!args.nnf_out.empty()) {
+    Image<float> f(res.nnf.width(), res.nnf.height(), 2);
+    for (int y = 0; y < f.height(); ++y)
+      for (int x = 0; x < f.width(); ++x)
+        for (int c = 0; c < 2; ++c) f(x, y, c) = float(res.nnf(x, y, c));
+    io::WriteOptions o;
+    o.format = io::SampleFormat::kFloat;
+    o.channel_names = {"nnf.X", "nnf.Y"};
+    io::write_image(args.nnf_out, f.cview(), o);
+  }
+  if (!args.error_out.empty()) {
+    io::WriteOptions o;
+    o.format = io::SampleFormat::kFloat;
+    o.channel_names = {"error.Y"};
+    io::write_image(args.error_out, res.error.cview(), o);
+  }
 }
 
 }  // namespace
@@ -245,20 +160,47 @@ int run_synth(const Args& argv) {
     std::fputs(kHelp, stdout);
     return 0;
   }
-  check_output_paths(args);
+  // Fail on an unwritable output before any long work.
+  check_output_path("-output", args.output);
+  if (!args.nnf_out.empty()) check_output_path("--nnf-out", args.nnf_out);
+  if (!args.error_out.empty()) check_output_path("--error-out", args.error_out);
   set_thread_count(args.threads);
 
   const auto t0 = std::chrono::steady_clock::now();
-  SynthFiles files = load_files(args);
-  synth::Result res = run_engine(args, files);
+  std::vector<io::AnyImage> files = read_files(args);
+  const auto t_read = std::chrono::steady_clock::now();
+  const std::clock_t cpu_read = std::clock();  // CPU time of every thread of the process
+  synth::RuledInputs ruled = ruled_inputs(args, files);
+  synth::Params params = args.params;
+  params.style_weight = args.style_weight;
+  synth::OutputRequest req;
+  req.nnf = !args.nnf_out.empty();
+  req.error = !args.error_out.empty();
+  synth::Synthesizer synthesizer(ruled.inputs, params);
+  // The guides are packed into the engine's features now; free them before the long part.
+  ruled.release_guides();
+  for (std::size_t i = 1; i < 1 + 2 * args.guides.size(); ++i) files[i] = io::AnyImage();
+  synth::Result res = synthesizer.run(req);
   const auto t1 = std::chrono::steady_clock::now();
-  const int width = res.image.width(), height = res.image.height();
-  write_outputs(args, files, res);
-  if (!args.quiet)
-    std::fprintf(
-        stderr, "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s\n",
-        width, height, files.style.width(), files.style.height(), files.channels.style_channels,
-        args.guides.size(), res.pyramid_levels, std::chrono::duration<double>(t1 - t0).count());
+  const double cpu_seconds = double(std::clock() - cpu_read) / CLOCKS_PER_SEC;
+
+  io::WriteOptions wo;
+  wo.format = output_format(args.depth, files[0].type());
+  // A one-channel style (an RGB file whose channels are equal, say) is written back as RGB, as
+  // EbSynth does.
+  const int ns = synth::plane_channels(ruled.inputs.style);
+  const Image<float> out_img = ns == 1 ? synth::gray_to_rgb(res.image) : std::move(res.image);
+  io::write_image(args.output, out_img.cview(), wo);
+  write_field_and_error(args, res);
+  if (!args.quiet) {
+    using seconds = std::chrono::duration<double>;
+    std::fprintf(stderr,
+                 "emaki synth: %dx%d from %dx%d, %d channels + %zu guides, %d levels, %.2f s "
+                 "(reading %.3f s, synthesis %.3f s, %.3f CPU s)\n",
+                 out_img.width(), out_img.height(), files[0].width(), files[0].height(), ns,
+                 args.guides.size(), res.pyramid_levels, seconds(t1 - t0).count(),
+                 seconds(t_read - t0).count(), seconds(t1 - t_read).count(), cpu_seconds);
+  }
   return 0;
 }
 

@@ -1,4 +1,5 @@
-// `emaki synth`'s argument parser and EbSynth's channel rules (see synth_args.h).
+// `emaki synth`'s argument parser (see synth_args.h); EbSynth's channel rules are
+// synth/ebsynth_rules.
 #include "apps/emaki/synth_args.h"
 
 #include <fmt/format.h>
@@ -212,71 +213,6 @@ SynthArgs parse_synth_args(const std::vector<std::string>& args) {
     if (!map.empty())
       throw Error("--guide-weight-map", fmt::format("guide {} has two weight maps", n));
     map = file;
-  }
-  return r;
-}
-
-int effective_channels(const io::AnyImage& im) {
-  const int nc = im.channels();
-  const int w = im.width(), h = im.height();
-  auto opaque = [&](int c) {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        if (im.value(x, y, c) != 1.0f) return false;
-    return true;
-  };
-  auto gray = [&]() {
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const float r = im.value(x, y, 0);
-        if (im.value(x, y, 1) != r || im.value(x, y, 2) != r) return false;
-      }
-    return true;
-  };
-  if (nc == 4) return opaque(3) ? (gray() ? 1 : 3) : 4;
-  if (nc == 3) return gray() ? 1 : 3;
-  if (nc == 2) return opaque(1) ? 1 : 2;
-  return nc;
-}
-
-io::AnyImage with_channels(io::AnyImage im, int channels) {
-  const int have = im.channels();
-  if (have == channels) return im;
-  if (have > channels) return im.select_channels(0, channels);
-  io::AnyImage out;
-  std::visit(
-      [&](const auto& src) {
-        using T = std::decay_t<decltype(src(0, 0))>;
-        Image<T> o(src.width(), src.height(), channels);
-        const bool gray = have <= 2;
-        for (int y = 0; y < src.height(); ++y)
-          for (int x = 0; x < src.width(); ++x)
-            for (int c = 0; c < channels; ++c) {
-              int from = std::min(c, have - 1);
-              if (gray) from = c < 3 ? 0 : have - 1;
-              o(x, y, c) = src(x, y, from);
-            }
-        out.image = std::move(o);
-      },
-      im.image);
-  return out;
-}
-
-SynthChannels resolve_channels(const SynthArgs& args, int style_channels,
-                               const std::vector<std::array<int, 2>>& guide_channels) {
-  CHECK_EQ(guide_channels.size(), args.guides.size());
-  SynthChannels r;
-  r.style_channels = style_channels;
-  if (args.style_weight >= 0.0f) r.style_weight = args.style_weight;
-  for (std::size_t k = 0; k < args.guides.size(); ++k) {
-    const SynthGuideArg& g = args.guides[k];
-    const auto [source, target] = guide_channels[k];
-    if (source > 4)
-      throw Error(g.source, fmt::format("a guide must have 1 to 4 channels (has {})", source));
-    if (target > 4)
-      throw Error(g.target, fmt::format("a guide must have 1 to 4 channels (has {})", target));
-    const float weight = g.weight >= 0.0f ? g.weight : 1.0f / float(args.guides.size());
-    r.guides.push_back({std::max(source, target), weight});
   }
   return r;
 }

@@ -5,6 +5,7 @@
 // are explicit (clone()).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -114,5 +115,26 @@ class Image {
 };
 
 using ImageF = Image<float>;
+
+// A value as an 8- or 16-bit sample: clamped to [0, 1], then rounded to nearest. PNG files and
+// the Python module's integer results are made by these, so they agree to the bit.
+inline uint8_t to_u8(float v) {
+  return uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+}
+inline uint16_t to_u16(float v) {
+  return uint16_t(std::clamp(v, 0.0f, 1.0f) * 65535.0f + 0.5f);
+}
+
+// The inverse direction: an 8- or 16-bit sample as a value in [0, 1] (floats as they are). Every
+// reader normalises so, so that "opaque" (1) means the same whichever front end loaded an image.
+template <typename T>
+float normalised(T v) {
+  if constexpr (std::is_same_v<T, uint8_t>)
+    return v * (1.0f / 255.0f);
+  else if constexpr (std::is_same_v<T, uint16_t>)
+    return v * (1.0f / 65535.0f);
+  else
+    return v;
+}
 
 }  // namespace emaki

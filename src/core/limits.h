@@ -80,6 +80,16 @@ inline std::string echo(std::string_view value, std::size_t cap = 80) {
   return out;
 }
 
+// A file or folder path in an error line: whole up to 400 bytes (studio paths run past 80 and
+// the file name at the end is what the user needs); a longer one keeps its first 100 and last
+// 280 bytes around "...(N bytes)...", so the line stays short and still ends in the file name.
+inline std::string echo_path(std::string_view path) {
+  constexpr std::size_t kWhole = 400, kHead = 100, kTail = 280;
+  if (path.size() <= kWhole) return echo(path, kWhole);
+  return echo(path.substr(0, kHead), kHead) + "...(" + std::to_string(path.size()) + " bytes)..." +
+         echo(path.substr(path.size() - kTail), kTail);
+}
+
 // Throws Error(subject) when width x height is not a positive size within the pixel budget.
 // Call it with the sizes a header claims, before allocating anything.
 inline void check_pixel_budget(const std::string& subject, int64_t width, int64_t height) {

@@ -19,8 +19,20 @@ namespace {
 std::mutex g_mutex;
 int g_threads = 0;
 std::unique_ptr<tbb::task_arena> g_arena;
+// This thread's ScopedThreadCount, if any.
+thread_local ScopedThreadCount::Arena* t_arena = nullptr;
+
+}  // namespace
+
+struct ScopedThreadCount::Arena {
+  tbb::task_arena arena;
+  explicit Arena(int n) : arena(n) {}
+};
+
+namespace {
 
 tbb::task_arena& arena() {
+  if (t_arena) return t_arena->arena;
   std::lock_guard lock(g_mutex);
   // Without this, TBB sizes its worker pool by the first arena it sees: a first run with one
   // thread would cap every later run at one. Allowing plenty lets each arena get what it asks.
@@ -34,6 +46,17 @@ tbb::task_arena& arena() {
   return *g_arena;
 }
 }  // namespace
+
+ScopedThreadCount::ScopedThreadCount(int n) : previous_(t_arena) {
+  if (n <= 0) return;
+  arena();  // sets TBB's global parallelism limit before the first arena is made
+  arena_ = std::make_unique<Arena>(n);
+  t_arena = arena_.get();
+}
+
+ScopedThreadCount::~ScopedThreadCount() {
+  t_arena = previous_;
+}
 
 void set_thread_count(int n) {
   std::lock_guard lock(g_mutex);

@@ -4,12 +4,31 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 namespace emaki {
 
 // Sets the number of worker threads used by parallel_for (0 = all hardware threads).
 void set_thread_count(int n);
 int thread_count();
+
+// While it lives, parallel_for calls made on the constructing thread use at most `n` threads
+// (0: the process-wide setting), leaving the process-wide setting alone: callers on different
+// threads (Python threads, each with its own `threads` argument) never disturb one another.
+// set_thread_count, by contrast, must not run while another thread is inside parallel_for.
+class ScopedThreadCount {
+ public:
+  explicit ScopedThreadCount(int n);
+  ~ScopedThreadCount();
+  ScopedThreadCount(const ScopedThreadCount&) = delete;
+  ScopedThreadCount& operator=(const ScopedThreadCount&) = delete;
+
+  struct Arena;
+
+ private:
+  std::unique_ptr<Arena> arena_;
+  Arena* previous_ = nullptr;
+};
 
 // Calls fn(begin, end) over [0, n) in chunks of `grain` items, in parallel.
 void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn);

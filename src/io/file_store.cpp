@@ -204,10 +204,10 @@ void FileStore::prepare() {
   }
 }
 
-bool FileStore::prepared() const {
+bool FileStore::prepared(bool with_pass_cache) const {
   for (const auto& [name, m] : layers_)
     if (!m.current) return false;
-  return frames_.current && (passes_.current || shot_.source.kind != pipeline::SourceKind::kScene);
+  return frames_.current && (passes_.current || !with_pass_cache);
 }
 
 bool FileStore::has_passes(int frame) const {

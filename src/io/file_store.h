@@ -67,8 +67,9 @@ class FileStore : public pipeline::Store {
   // The pass cache: a scene source's guide passes per frame, rendered once and read by every
   // task of the shot (float EXR, so read back bit for bit).
   bool has_passes(int frame) const;
-  // Every manifest is current: the farm's prepare task has nothing left to do.
-  bool prepared() const;
+  // Every manifest the farm's tasks write under is current (the pass cache's only when
+  // `with_pass_cache`): the prepare task has nothing left to do.
+  bool prepared(bool with_pass_cache) const;
   void write_passes(int frame, ImageView<const float> passes);
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;

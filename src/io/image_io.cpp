@@ -40,18 +40,6 @@ PixelType AnyImage::type() const {
                               : PixelType::kF32;
 }
 
-namespace {
-template <typename T>
-float normalised(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>)
-    return v * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>)
-    return v * (1.0f / 65535.0f);
-  else
-    return v;
-}
-}  // namespace
-
 float AnyImage::value(int x, int y, int c) const {
   return std::visit([&](const auto& im) { return normalised(im(x, y, c)); }, image);
 }
@@ -107,13 +95,18 @@ const OiioBackend& oiio_backend(const std::string& subject) {
   std::call_once(once, [] {
     std::vector<std::string> candidates;
     if (const char* env = std::getenv("EMAKI_OIIO_MODULE")) candidates.push_back(env);
-    // Beside the executable (installed layouts), then where the build put it.
+    // Beside the executable (installed layouts) or the shared object holding this code (the
+    // Python module), then where the build put it.
     std::error_code ec;
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (!ec) {
       candidates.push_back((exe.parent_path() / "libemaki_io_oiio.so").string());
       candidates.push_back((exe.parent_path() / "../lib/emaki/libemaki_io_oiio.so").string());
     }
+    Dl_info self{};
+    if (dladdr(reinterpret_cast<void*>(&oiio_backend), &self) != 0 && self.dli_fname)
+      candidates.push_back(
+          (fs::path(self.dli_fname).parent_path() / "libemaki_io_oiio.so").string());
 #ifdef EMAKI_OIIO_MODULE_PATH
     candidates.push_back(EMAKI_OIIO_MODULE_PATH);
 #endif

@@ -251,14 +251,13 @@ void write_png(std::FILE* opened, ImageView<const float> image, bool sixteen_bit
   for (int y = 0; y < h; ++y) {
     const float* r = image.row(y);
     for (int i = 0; i < w * nc; ++i) {
-      const float v = std::clamp(r[i], 0.0f, 1.0f);
       const std::size_t o = (std::size_t(y) * w * nc + i) * bytes;
       if (sixteen_bit) {
-        const unsigned q = unsigned(v * 65535.0f + 0.5f);
+        const unsigned q = to_u16(r[i]);
         buf[o] = (unsigned char)(q >> 8);  // big-endian
         buf[o + 1] = (unsigned char)(q & 255);
       } else {
-        buf[o] = (unsigned char)(v * 255.0f + 0.5f);
+        buf[o] = to_u8(r[i]);
       }
     }
   }

@@ -29,6 +29,15 @@ void add_light(Lines& l, const std::string& p, const scene::LightSpec& s) {
   l.add(p + "softness", s.softness_deg);
 }
 
+void add_object(Lines& l, std::size_t i, const pipeline::SceneObject& o) {
+  const std::string p = fmt::format("source.objects[{}]", i);
+  l.add(p + ".scene", o.scene);
+  l.add(p + ".scene.digest", file_digest(o.scene));
+  l.add(p, fmt::format("translate {} rotate {} scale {} velocity {} clip {} start {} loop {} id {}",
+                       v3(o.translate), v3(o.rotate_deg), v3(o.scale), v3(o.velocity), o.clip,
+                       o.start, o.loop, o.id));
+}
+
 // Everything that decides the guide passes of a frame.
 void add_source(Lines& l, const pipeline::Shot& shot) {
   const pipeline::Source& s = shot.source;
@@ -36,8 +45,11 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
   // The temporal chain starts at the first frame: every later frame depends on it.
   l.add("source.first_frame", s.first_frame);
   if (s.kind == pipeline::SourceKind::kScene) {
-    l.add("source.scene", s.scene_path);
-    l.add("source.scene.digest", file_digest(s.scene_path));
+    if (s.objects.empty()) {
+      l.add("source.scene", s.scene_path);
+      l.add("source.scene.digest", file_digest(s.scene_path));
+    }
+    for (std::size_t i = 0; i < s.objects.size(); ++i) add_object(l, i, s.objects[i]);
     const scene::ShotSpec& sh = s.shot;
     const scene::CameraSpec& c = sh.camera;
     l.add("source.camera",

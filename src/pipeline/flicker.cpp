@@ -44,6 +44,8 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
       out.all.sum += e, ++out.all.pixels;
       FlickerStats& s = id >= 2.0f ? out.objects : out.ground;
       s.sum += e, ++s.pixels;
+      FlickerStats& o = out.by_id[int(std::lround(id))];
+      o.sum += e, ++o.pixels;
     }
   return out;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 
 #include "core/image.h"
 #include "pipeline/frames.h"
@@ -21,15 +22,20 @@ struct FlickerStats {
 struct FrameFlicker {
   int frame = 0;
   FlickerStats all, objects, ground;  // objects: id >= 2; ground: id 1
+  std::map<int, FlickerStats> by_id;  // per value of the object_id pass (1: the ground)
 };
 
-// A sequence's flicker: the frame means averaged with equal weight per frame.
+// A sequence's flicker: the frame means averaged with equal weight per frame (`pixels` counts
+// the frames). Per object id, over the frames in which the id has pixels measured.
 struct SequenceFlicker {
   FlickerStats all, objects, ground;
+  std::map<int, FlickerStats> by_id;
   void add(const FrameFlicker& f) {
     all.sum += f.all.mean(), all.pixels += 1;
     objects.sum += f.objects.mean(), objects.pixels += 1;
     ground.sum += f.ground.mean(), ground.pixels += 1;
+    for (const auto& [id, s] : f.by_id)
+      if (s.pixels > 0) by_id[id].sum += s.mean(), by_id[id].pixels += 1;
   }
 };
 

@@ -150,6 +150,37 @@ TEST(Pipeline, FlickerFollowsMotion) {
   EXPECT_EQ(glued.ground.pixels, 0);
 }
 
+// Per object id: the left part of the frame (object 2) carries a value glued to the surface, the
+// right part (object 5) one that stands still while the surface slides; only 5 flickers, and a
+// sequence averages each id over the frames it was measured in.
+TEST(Pipeline, FlickerBreaksDownByObjectId) {
+  const SlidingFrames f(40, 30);
+  Image<float> p0 = f.passes(0), p1 = f.passes(1);
+  Image<float> v0(40, 30, 1), v1(40, 30, 1);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x) {
+      const bool right = x >= 24;
+      p0(x, y, render::kObjectId) = p1(x, y, render::kObjectId) = right ? 5.0f : 2.0f;
+      v0(x, y) = p0(x, y, render::kNormal);
+      v1(x, y) = right ? v0(x, y) : p1(x, y, render::kNormal);
+    }
+  const FrameFlicker ff = frame_flicker(v1.cview(), v0.cview(), p1.cview(), p0.cview(), -1);
+  ASSERT_EQ(ff.by_id.size(), 2u);
+  EXPECT_GT(ff.by_id.at(2).pixels, 300);
+  EXPECT_GT(ff.by_id.at(5).pixels, 300);
+  EXPECT_EQ(ff.by_id.at(2).pixels + ff.by_id.at(5).pixels, ff.all.pixels);
+  EXPECT_NEAR(ff.by_id.at(2).mean(), 0.0, 1e-6);
+  EXPECT_NEAR(ff.by_id.at(5).mean(), 1.0 / 40, 1e-4);
+  SequenceFlicker seq;
+  seq.add(ff);
+  FrameFlicker only_two;
+  only_two.by_id[2] = {0.5, 10};
+  seq.add(only_two);
+  EXPECT_NEAR(seq.by_id.at(2).mean(), 0.025, 1e-6);     // (0 + 0.05) / 2 frames
+  EXPECT_NEAR(seq.by_id.at(5).mean(), 1.0 / 40, 1e-4);  // measured in one frame only
+  EXPECT_EQ(seq.by_id.at(5).pixels, 1);
+}
+
 TEST(Pipeline, RunsResumesAndContinuesTheChain) {
   const Shot shot = tiny_shot();
   const SlidingFrames frames(40, 30);

@@ -32,13 +32,25 @@ struct ChannelMapping {
   std::vector<std::string> channels;  // the file's channel names, as many as the pass has
 };
 
+// One asset of a scene assembled in the shot file (source.objects; scene/assembly.h).
+struct SceneObject {
+  std::string scene;  // the glTF file
+  glm::vec3 translate{0.0f}, rotate_deg{0.0f}, scale{1.0f}, velocity{0.0f};
+  std::string clip;  // empty: the first clip, if any
+  float start = 0.0f;
+  bool loop = false;
+  int id = 2;  // object_id pass value of everything it draws
+};
+
 struct Source {
   SourceKind kind = SourceKind::kScene;
   int first_frame = 0, last_frame = 0;  // inclusive
   int width = 0, height = 0;
   float fps = 24.0f;
-  // kScene
+  // kScene: one file, or objects assembled into one scene (scene_path empty; shot.clip is then
+  // scene::kAssemblyClip)
   std::string scene_path;
+  std::vector<SceneObject> objects;
   scene::ShotSpec shot;          // camera, light, ground, clip; frames mirror first/last_frame
   render::RenderOptions render;  // width/height mirror the source's size
   // kSequence

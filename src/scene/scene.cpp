@@ -84,7 +84,15 @@ void sample(const AnimSampler& s, float t, bool is_rotation, float* out) {
 // ---------------------------------------------------------------------------------------------
 // Pose
 
-Pose evaluate_pose(const Scene& scene, int animation, float t) {
+namespace {
+float channel_time(const AnimChannel& ch, float t) {
+  double x = double(t) + ch.time_offset;
+  if (ch.loop_length > 0.0) x -= std::floor(x / ch.loop_length) * ch.loop_length;
+  return float(ch.time_base + x);
+}
+}  // namespace
+
+Pose evaluate_pose(const Scene& scene, int animation, float time) {
   const int n = int(scene.nodes.size());
   Pose pose;
   pose.translation.resize(n);
@@ -95,6 +103,7 @@ Pose evaluate_pose(const Scene& scene, int animation, float t) {
   for (int i = 0; i < n; ++i) {
     const Node& node = scene.nodes[i];
     pose.translation[i] = node.translation;
+    if (node.velocity != glm::vec3(0.0f)) pose.translation[i] += time * node.velocity;
     pose.rotation[i] = node.rotation;
     pose.scale[i] = node.scale;
     pose.weights[i] = node.weights;
@@ -104,6 +113,7 @@ Pose evaluate_pose(const Scene& scene, int animation, float t) {
     float buf[4];
     for (const AnimChannel& ch : anim.channels) {
       const AnimSampler& s = anim.samplers.at(ch.sampler);
+      const float t = channel_time(ch, time);
       switch (ch.path) {
         case AnimPath::kTranslation:
           sample(s, t, false, buf);
@@ -151,7 +161,7 @@ Pose evaluate_pose(const Scene& scene, int animation, float t) {
           throw Error(scene.source,
                       fmt::format("node {} ('{}') has a non-finite world transform at {} s (its "
                                   "transforms or animation values overflow)",
-                                  i, echo(node.name), t));
+                                  i, echo(node.name), time));
     for (int c : node.children) stack.push_back(c);
   }
   return pose;
@@ -259,7 +269,7 @@ void pose_primitive(const Scene& scene, const Pose& pose, JointMatrices& joints,
                               node_index, echo(node.name), v, p.x, p.y, p.z, kMaxWorldCoordinate));
   }
   if (!has_normals) smooth_normals(out.world_positions, prim.indices, out.world_normals);
-  out.rest_positions = &prim.positions;
+  out.rest_positions = prim.rest_positions.empty() ? &prim.positions : &prim.rest_positions;
   out.uvs = &prim.uvs;
   out.indices = &prim.indices;
   out.material = prim.material;
@@ -285,7 +295,7 @@ PosedScene pose_scene(const Scene& scene, int animation, float t) {
         out.node = i;
         out.mesh = node.mesh;
         out.primitive = p;
-        out.object_id = posed.object_count;
+        out.object_id = node.object_id >= 0 ? node.object_id : posed.object_count;
         pose_primitive(scene, pose, joints, i, mesh.primitives[p], weights, out);
         posed.primitives.push_back(std::move(out));
       }

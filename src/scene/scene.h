@@ -44,6 +44,10 @@ struct Primitive {
   std::vector<uint32_t> indices;  // 3 per triangle
   std::vector<MorphTarget> targets;
   int material = -1;  // index into Scene::materials, -1: the default material
+  // The rest_position pass's positions when they are not `positions` (empty: `positions`). An
+  // assembly (scene/assembly.h) gives each asset's rest pose in the asset's own unit cube, so
+  // that small and large assets keep the same precision in the pass.
+  std::vector<glm::vec3> rest_positions;
 };
 
 struct Mesh {
@@ -80,6 +84,11 @@ struct Node {
   int skin = -1;
   int camera = -1;
   std::vector<float> weights;  // morph weights overriding the mesh's defaults
+  // Moves the node by t x velocity at time t (an assembly's object walking through the shot).
+  glm::vec3 velocity{0.0f};
+  // The object id of the mesh drawn here (PosedPrimitive::object_id); -1: the next in hierarchy
+  // order. An assembly gives all of one asset's meshes its object's id.
+  int object_id = -1;
 };
 
 enum class AnimPath { kTranslation, kRotation, kScale, kWeights };
@@ -96,6 +105,12 @@ struct AnimChannel {
   int node = -1;
   AnimPath path = AnimPath::kTranslation;
   int sampler = -1;
+  // The channel's own clock, for an animation that plays several clips at once (an assembly,
+  // scene/assembly.h, plays each object's clip from its own start, looped or not): at time t
+  // the sampler is read at time_base + x, x = t + time_offset wrapped into [0, loop_length)
+  // when loop_length > 0 (in double, so frame f and f + one cycle land on the same time). A
+  // file's own clips leave all three at 0: the sampler is read at t.
+  double time_base = 0.0, time_offset = 0.0, loop_length = 0.0;
 };
 
 struct Animation {
@@ -147,7 +162,8 @@ Pose evaluate_pose(const Scene& scene, int animation, float t);
 inline constexpr float kMaxWorldCoordinate = 1e12f;
 
 // One drawn mesh primitive posed at one time. object_id counts the drawn (node, mesh) pairs in
-// hierarchy order from 0; material is the Scene material index (-1: default).
+// hierarchy order from 0 unless the node gives its own (Node::object_id); material is the Scene
+// material index (-1: default).
 struct PosedPrimitive {
   int node = -1;
   int mesh = -1;
@@ -156,7 +172,7 @@ struct PosedPrimitive {
   int material = -1;
   std::vector<glm::vec3> world_positions;
   std::vector<glm::vec3> world_normals;                    // unit length
-  const std::vector<glm::vec3>* rest_positions = nullptr;  // object space, bind pose
+  const std::vector<glm::vec3>* rest_positions = nullptr;  // Primitive::rest_positions or bind pose
   const std::vector<glm::vec2>* uvs = nullptr;             // may be empty
   const std::vector<uint32_t>* indices = nullptr;
 };

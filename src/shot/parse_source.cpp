@@ -28,16 +28,16 @@ void check_pattern(const std::string& key, const std::string& pattern) {
       width = width * 10 + (pattern[j++] - '0');
       if (width > io::kMaxFrameWidth)
         throw Error(key, fmt::format("'{}': the frame number's width must be at most {}",
-                                     echo(pattern), io::kMaxFrameWidth));
+                                     echo_path(pattern), io::kMaxFrameWidth));
     }
     if (j >= pattern.size() || pattern[j] != 'd')
-      throw Error(key, fmt::format("'{}': only %d or %0Nd may follow '%'", echo(pattern)));
+      throw Error(key, fmt::format("'{}': only %d or %0Nd may follow '%'", echo_path(pattern)));
     ++count;
     i = j;
   }
   if (count != 1)
-    throw Error(key,
-                fmt::format("'{}' must contain exactly one frame number (%04d)", echo(pattern)));
+    throw Error(
+        key, fmt::format("'{}' must contain exactly one frame number (%04d)", echo_path(pattern)));
 }
 
 // source.frames: checked as int64 before narrowing, so 4294967297 cannot quietly become 1.
@@ -110,7 +110,12 @@ void parse_light_and_ground(const Reader& r, scene::ShotSpec& shot) {
 
 void parse_scene_source(const Reader& r, const PathContext& ctx, pipeline::Source& s) {
   s.kind = pipeline::SourceKind::kScene;
-  s.scene_path = ctx.input_file(r, "scene", true);
+  if (r.has("objects")) {
+    for (const char* k : {"clip", "start", "loop"})
+      if (r.has(k)) throw Error(r.key_path(k), "applies to 'scene'; each of 'objects' has its own");
+  } else {
+    s.scene_path = ctx.input_file(r, "scene", true);
+  }
   if (!r.has("size")) throw Error(r.key_path("size"), "is required ([width, height])");
   const std::vector<float> size = r.numbers("size", 2);
   for (float v : size)
@@ -135,7 +140,10 @@ void parse_scene_source(const Reader& r, const PathContext& ctx, pipeline::Sourc
   if (const toml::table* t = r.table("camera")) {
     Reader c(*t, r.key_path("camera"), "source.camera");
     parse_camera(c, s.shot.camera);
+    if (r.has("objects") && s.shot.camera.mode == scene::CameraSpec::Mode::kGltf)
+      throw Error(c.key_path("mode"), "\"gltf\" needs 'scene': objects bring no camera");
   }
+  if (r.has("objects")) parse_objects(r, ctx, s);
   parse_light_and_ground(r, s.shot);
   for (const char* k : {"channels", "preset", "view_layer", "normals", "up", "premultiplied"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'sequence' source only");
@@ -175,7 +183,7 @@ void parse_channel_mapping(const Reader& r, pipeline::Source& s) {
     list += (i ? ", " : "") + echo(have[i], 40);
   if (have.size() > 64) list += fmt::format(", ... ({} more)", have.size() - 64);
   throw Error(key, fmt::format("channel '{}' ({}) is not in '{}', which has: {}", echo(ch), what,
-                               echo(first), list.empty() ? "no channels" : list));
+                               echo_path(first), list.empty() ? "no channels" : list));
 }
 
 // The first frame must exist and carry every pass the pipeline may read; it gives the size.
@@ -184,7 +192,7 @@ std::string check_first_frame(const Reader& r, pipeline::Source& s, const std::s
   std::error_code ec;
   if (!fs::is_regular_file(first, ec))
     throw Error(r.key_path("sequence"),
-                fmt::format("no such file '{}' (frame {})", echo(first), s.first_frame));
+                fmt::format("no such file '{}' (frame {})", echo_path(first), s.first_frame));
   const std::vector<std::string> have = io::list_channels(first);
   auto has = [&](const std::string& ch) {
     return std::find(have.begin(), have.end(), ch) != have.end();
@@ -239,7 +247,7 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
   s.z_up = r.choice("up", false, kUpAxes);
   s.premultiplied = r.boolean("premultiplied", false);
   for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera", "light",
-                        "ground", "background", "size"})
+                        "ground", "background", "size", "objects"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");
   parse_channel_mapping(r, s);
   const std::string first = io::frame_file(s.pattern, s.first_frame);
@@ -252,13 +260,14 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
 }  // namespace
 
 void parse_source(const Reader& r, const PathContext& ctx, pipeline::Source& s) {
-  const bool has_scene = r.has("scene"), has_sequence = r.has("sequence");
-  if (has_scene == has_sequence)
-    throw Error(r.path(), has_scene ? "give either 'scene' or 'sequence', not both"
-                                    : "needs 'scene' (a glTF file) or 'sequence' (EXR frames)");
+  const int given = r.has("scene") + r.has("objects") + r.has("sequence");
+  if (given != 1)
+    throw Error(r.path(), given ? "give one of 'scene', 'objects' or 'sequence', not several"
+                                : "needs 'scene' (a glTF file), 'objects' (glTF assets placed in "
+                                  "the shot) or 'sequence' (EXR frames)");
   parse_frames(r, s);
   s.fps = r.real("fps", s.fps);
-  if (has_scene)
+  if (!r.has("sequence"))
     parse_scene_source(r, ctx, s);
   else
     parse_sequence_source(r, ctx, s);

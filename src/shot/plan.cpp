@@ -89,17 +89,22 @@ class Planner {
     exemplar_pixels_ = exemplar_pixels(s);
 
     const bool scene = s.source.kind == pipeline::SourceKind::kScene;
-    bool prepared = state.prepared();
+    // Each task is done when its own outputs are there under current manifests (what `emaki run`
+    // resumes from): a shot run on one machine has no pass cache, and needs none.
+    auto passes_done = [&](int a, int b) {
+      for (int f = a; f <= b; ++f)
+        if (!state.has_passes(f) && !finished(s, state, f)) return false;
+      return true;
+    };
+    const bool need_cache = scene && !passes_done(first, last);
     const std::string prepare =
-        add(index, TaskKind::kPrepare, "", first, last, {out}, {}, prepared);
+        add(index, TaskKind::kPrepare, "", first, last, {out}, {}, state.prepared(need_cache));
     std::vector<std::string> passes;
     if (scene)
       for (int a = first; a <= last; a += o_.chunk) {
         const int b = std::min(last, a + o_.chunk - 1);
-        bool done = prepared;
-        for (int f = a; f <= b && done; ++f) done = state.has_passes(f) || finished(s, state, f);
-        passes.push_back(
-            add(index, TaskKind::kPasses, "", a, b, {out + "/passes"}, {prepare}, done));
+        passes.push_back(add(index, TaskKind::kPasses, "", a, b, {out + "/passes"}, {prepare},
+                             passes_done(a, b)));
       }
     const std::vector<std::string> before_layers = scene ? passes : std::vector{prepare};
     std::vector<std::string> layers;
@@ -107,7 +112,7 @@ class Planner {
       const int step = l.temporal.enabled ? last - first + 1 : o_.chunk;
       for (int a = first; a <= last; a += step) {
         const int b = std::min(last, a + step - 1);
-        bool done = prepared;
+        bool done = true;
         for (int f = a; f <= b && done; ++f) done = state.has_layer(l, f);
         layers.push_back(add(index, TaskKind::kLayer, l.name, a, b, {out + "/layers/" + l.name},
                              before_layers, done));
@@ -116,7 +121,7 @@ class Planner {
     std::vector<std::string> composites;
     for (int a = first; a <= last; a += o_.chunk) {
       const int b = std::min(last, a + o_.chunk - 1);
-      bool done = prepared;
+      bool done = true;
       for (int f = a; f <= b && done; ++f) done = state.has_frame(f);
       composites.push_back(add(index, TaskKind::kComposite, "", a, b,
                                {out + "/composite", out + "/layered"}, layers, done));
@@ -200,8 +205,8 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
     const std::string folder = fs::weakly_canonical(s.shot.outputs.folder).string();
     if (const auto it = folders.find(folder); it != folders.end())
       throw Error(Error::Field{"shots"},
-                  fmt::format("'{}' and '{}' write the same output folder '{}'", echo(it->second),
-                              echo(s.path), echo(folder)));
+                  fmt::format("'{}' and '{}' write the same output folder '{}'",
+                              echo_path(it->second), echo_path(s.path), echo_path(folder)));
     folders[folder] = s.path;
     if (s.name.empty()) s.name = fs::path(s.path).stem().string();
     if (const int n = names[s.name]++; n > 0) s.name += fmt::format("-{}", n + 1);

@@ -21,8 +21,18 @@ constexpr double kTwoPow40 = 1099511627776.0;
 constexpr KeySpec kSchema[] = {
     {.key = "threads", .type = "integer", .default_value = "`0`", .lo = 0, .hi = 1024, .meaning = "worker threads, 0 = all cores (results do not depend on it)"},
     {.key = "limits.max_pixels", .type = "integer", .default_value = "`268435456` (2^28)", .lo = 1, .hi = kTwoPow40, .range = "[1, 2^40]", .meaning = "the pixel budget: no image emaki reads or makes (frames, paintings, passes, paper) may hold more pixels; `source.size` is checked against it when the shot loads. `--max-pixels N` on the command line wins over it. See [Limits](#limits)"},
-    {.key = "source", .type = "table", .default_value = "required", .meaning = "where each frame's guide passes come from: exactly one of `scene` or `sequence`"},
+    {.key = "source", .type = "table", .default_value = "required", .meaning = "where each frame's guide passes come from: exactly one of `scene`, `objects` or `sequence`"},
     {.key = "source.scene", .type = "string (path)", .default_value = "—", .meaning = "a glTF 2.0 `.gltf`/`.glb` rendered by emaki's renderer"},
+    {.key = "source.objects", .type = "array of tables", .default_value = "—", .meaning = "instead of `scene`: a scene assembled from glTF assets, one `[[source.objects]]` table each, under the shot's camera, light and ground; each object plays its own clip (`source.clip`, `start`, `loop` and `camera.mode = \"gltf\"` are refused). See [Assembled scenes](#assembled-scenes-sourceobjects)"},
+    {.key = "source.objects[N].scene", .type = "string (path)", .default_value = "required", .meaning = "the asset, a glTF 2.0 `.gltf`/`.glb` (one file may be placed many times)"},
+    {.key = "source.objects[N].translate", .type = "[x, y, z]", .default_value = "`[0, 0, 0]`", .meaning = "where the asset's origin stands at frame 0, world units"},
+    {.key = "source.objects[N].rotate", .type = "[x, y, z]", .default_value = "`[0, 0, 0]`", .meaning = "degrees about the X, then the Y, then the Z axis (world axes)"},
+    {.key = "source.objects[N].scale", .type = "number or [x, y, z]", .default_value = "`1`", .lo = 1e-6, .hi = 1e6, .range = "each in [1e-6, 1e6]", .meaning = "scale, applied before the rotation"},
+    {.key = "source.objects[N].velocity", .type = "[x, y, z]", .default_value = "`[0, 0, 0]`", .meaning = "world units per second: the object moves in a straight line, to `translate` + f / fps x `velocity` at frame f"},
+    {.key = "source.objects[N].clip", .type = "string", .default_value = "first clip", .meaning = "the asset's glTF animation to play (an asset without one stands in its rest pose)"},
+    {.key = "source.objects[N].start", .type = "number", .default_value = "`0`", .lo = 0, .hi = 10000000.0, .meaning = "seconds into the object's clip at frame 0"},
+    {.key = "source.objects[N].loop", .type = "boolean", .default_value = "`false`", .meaning = "play the object's clip in a loop; off, a frame past the clip's end is an error"},
+    {.key = "source.objects[N].id", .type = "integer", .default_value = "one past the largest so far (first: 2)", .lo = 2, .hi = 65535, .meaning = "the `object_id` pass value of everything the object draws (0 is the background, 1 the ground); unique across objects"},
     {.key = "source.sequence", .type = "string (pattern)", .default_value = "—", .range = "exactly one `%d`/`%0Nd`, N <= 12", .meaning = "a studio render, one multilayer EXR per frame, e.g. `renders/frame_%04d.exr` (nothing else may follow a `%`)"},
     {.key = "source.frames", .type = "[int, int]", .default_value = "required", .range = "each in [0, 10000000], last >= first, at most 1000000 frames", .meaning = "first and last frame, inclusive"},
     {.key = "source.fps", .type = "number", .default_value = "`24`", .lo = 1, .hi = 240, .meaning = "frames per second: clip time of frame f is clip start + `start` + f / fps; MP4 rate"},
@@ -161,7 +171,8 @@ std::vector<std::string> child_keys(std::string_view prefix) {
         continue;
       rest.remove_prefix(prefix.size() + 1);
     }
-    const std::string child(rest.substr(0, rest.find('.')));
+    // "objects[N].scene" is a key under "objects" (an array of tables).
+    const std::string child(rest.substr(0, rest.find_first_of(".[")));
     if (std::find(out.begin(), out.end(), child) == out.end()) out.push_back(child);
   }
   return out;
@@ -170,8 +181,9 @@ std::vector<std::string> child_keys(std::string_view prefix) {
 std::string schema_markdown() {
   std::string md = "| key | type | default | range | meaning |\n|---|---|---|---|---|\n";
   for (const KeySpec& k : kSchema) {
-    const std::string key =
-        k.is_table() ? fmt::format("**`[{}]`**", k.key) : fmt::format("`{}`", k.key);
+    const std::string key = k.is_table()                  ? fmt::format("**`[{}]`**", k.key)
+                            : k.type == "array of tables" ? fmt::format("**`[[{}]]`**", k.key)
+                                                          : fmt::format("`{}`", k.key);
     md += fmt::format("| {} | {} | {} | {} | {} |\n", key, k.type, k.default_value, range_text(k),
                       k.meaning);
   }

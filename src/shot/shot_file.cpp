@@ -23,9 +23,9 @@ void check_output_folder(const std::string& key, const std::string& folder) {
   fs::path p(folder);
   if (fs::exists(p, ec)) {
     if (!fs::is_directory(p, ec))
-      throw Error(key, fmt::format("'{}' exists and is not a folder", echo(folder)));
+      throw Error(key, fmt::format("'{}' exists and is not a folder", echo_path(folder)));
     if (::access(p.c_str(), W_OK | X_OK) != 0)
-      throw Error(key, fmt::format("folder '{}' is not writable", echo(folder)));
+      throw Error(key, fmt::format("folder '{}' is not writable", echo_path(folder)));
     return;
   }
   // Not there yet: the nearest existing parent must let us create it.
@@ -34,7 +34,7 @@ void check_output_folder(const std::string& key, const std::string& folder) {
   if (parent.empty()) parent = ".";
   if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK | X_OK) != 0)
     throw Error(key, fmt::format("cannot create folder '{}': '{}' is not a writable folder",
-                                 echo(folder), echo(parent.string())));
+                                 echo_path(folder), echo_path(parent.string())));
 }
 
 int declared_line(const toml::node& n) {

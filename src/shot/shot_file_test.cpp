@@ -131,5 +131,15 @@ TEST(ShotFile, ChannelPresetKeysAreChecked) {
   });
 }
 
+// Studio paths run past 80 characters; an error about a file names all of it, file name included.
+TEST(ShotFile, ErrorsNameALongPathWhole) {
+  const std::string folder = "/nonexistent/" + std::string(150, 'd');
+  std::string text = minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n");
+  const std::size_t from = text.find("scene = "), to = text.find("size = [64, 48]\n");
+  text.replace(from, to + 16 - from,
+               "sequence = \"" + folder + "/frame_%04d.exr\"\nframes = [0, 3]\n");
+  expect_errors({{text, "source.sequence: no such file '" + folder + "/frame_0000.exr'"}});
+}
+
 }  // namespace
 }  // namespace emaki::shot

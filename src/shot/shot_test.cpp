@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "io/image_io.h"
 
 namespace emaki::shot {
 namespace {
@@ -60,6 +61,50 @@ TEST_F(ShotApi, RunResumesAndComposites) {
   ASSERT_EQ(f.frames.size(), 2u);
   EXPECT_EQ(f.frames[0].frame, 1);
   EXPECT_GT(f.mean.all.mean(), 0.0);
+}
+
+// Two styles mixed: the hatching layer's blend is a compositing setting, so changing only it
+// re-colours the finished layers (no synthesis, layer files untouched) and changes the mix.
+TEST_F(ShotApi, HatchingBlendChangesTheMixWithoutSynthesis) {
+  auto text = [&](const std::string& blend) {
+    return "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nclip = \"Walk\"\n" +
+           "frames = [0, 1]\nsize = [48, 32]\naa = 1\n[exemplars.pastel]\npainting = \"" + kData +
+           "/stylit/source_style.png\"\n[exemplars.hatching]\npainting = \"" + EMAKI_SOURCE_DIR +
+           "/examples/town/hatching.png\"\nsphere = [400, 300, 180]\n[layers.base]\n" +
+           "kind = \"base\"\nexemplar = \"pastel\"\n[layers.hatching]\nexemplar = \"hatching\"\n" +
+           "guides = { normal = 1, diffuse = 1 }\nmask = \"covered\"\nalpha = \"inverse_value\"\n" +
+           "gradient = [[0, 0.2, 0.15, 0.3], [1, 1, 1, 1]]\nopacity = 0.8\nblend = \"" + blend +
+           "\"\n[outputs]\nfolder = \"" + folder_.string() + "\"\nmp4 = false\n";
+  };
+  const std::string path = (folder_.parent_path() / "mix.toml").string();
+  const pipeline::Shot multiply = open_text(text("multiply"), path);
+  Request r;
+  r.previews = false;
+  EXPECT_EQ(run(multiply, r).report.synthesized, 4);
+  const fs::path frame = folder_ / "composite" / "frame_0001.png";
+  const fs::path layer = folder_ / "layers" / "hatching" / "hatching_0001.exr";
+  const Image<float> before = io::read_image_float(frame.string());
+  const Image<float> layer_before = io::read_image_float(layer.string());
+  const auto layer_time = fs::last_write_time(layer);
+
+  const pipeline::Shot screen = open_text(text("screen"), path);
+  EXPECT_EQ(composite(screen, r).composited, 2);
+  const Image<float> after = io::read_image_float(frame.string());
+  int changed = 0;  // pixels that moved by more than one 8-bit step
+  for (int y = 0; y < after.height(); ++y)
+    for (int x = 0; x < after.width(); ++x)
+      for (int c = 0; c < 3; ++c)
+        changed += std::abs(after(x, y, c) - before(x, y, c)) > 1 / 255.0f;
+  EXPECT_GT(changed, 20);
+  EXPECT_EQ(fs::last_write_time(layer), layer_time);
+  const Image<float> layer_after = io::read_image_float(layer.string());
+  for (int y = 0; y < layer_after.height(); ++y)
+    for (int x = 0; x < layer_after.width(); ++x)
+      ASSERT_EQ(layer_after(x, y, 0), layer_before(x, y, 0));
+  // A run with the new blend finds every layer frame finished: the blend is not synthesis.
+  const RunResult again = run(screen, r);
+  EXPECT_EQ(again.report.synthesized, 0);
+  EXPECT_EQ(again.report.reused, 4);
 }
 
 Error error_of(const std::function<void()>& f) {

@@ -232,7 +232,7 @@ std::string PathContext::input_file(const Reader& r, std::string_view key, bool 
   const std::string p = resolve(raw);
   std::error_code ec;
   if (!fs::is_regular_file(p, ec))
-    throw Error(r.key_path(key), fmt::format("no such file '{}'", echo(p)));
+    throw Error(r.key_path(key), fmt::format("no such file '{}'", echo_path(p)));
   return p;
 }
 

@@ -296,6 +296,7 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   Image<int32_t> snap(L.tw, std::max<int>(1, int(snap_rows.size())), 2);
   std::vector<int32_t> occ, occ_scratch;
   for (int iter = 0; iter < C.iterations; ++iter) {
+    if (C.before_sweep) (*C.before_sweep)();
     for (std::size_t k = 0; k < snap_rows.size(); ++k)
       std::memcpy(snap.row(int(k)), L.nnf->row(snap_rows[k]),
                   std::size_t(L.tw) * 2 * sizeof(int32_t));

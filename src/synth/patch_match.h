@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/image.h"
@@ -55,6 +56,9 @@ struct PatchMatchConfig {
   const int16_t* group_masks = nullptr;
   std::ptrdiff_t group_mask_stride = 0;
   int groups = 1;
+  // Called on the calling thread before each sweep, when set; it may throw to stop the run
+  // (cancellation), and otherwise changes nothing.
+  const std::function<void()>* before_sweep = nullptr;
 };
 
 // The distance between the target patch centred at (x, y) (top-left element t) and a source

@@ -120,16 +120,17 @@ int max_pyramid_levels(int sw, int sh, int tw, int th, int patch_size) {
 }
 
 void validate(const Inputs& in, const Params& p) {
+  using F = Error::Field;
   if (p.patch_size < 3 || p.patch_size % 2 == 0)
-    throw Error("patch size", fmt::format("must be odd and >= 3 (got {})", p.patch_size));
+    throw Error(F{"patch_size"}, fmt::format("must be odd and >= 3 (got {})", p.patch_size));
   if (!(p.uniformity >= 0.0f) || !std::isfinite(p.uniformity))
-    throw Error("uniformity", "must be a finite number >= 0");
+    throw Error(F{"uniformity"}, "must be a finite number >= 0");
   if (p.pyramid_levels == 0 || p.pyramid_levels < -1)
-    throw Error("pyramid levels", fmt::format("must be >= 1 (got {})", p.pyramid_levels));
-  if (p.search_vote_iters < -1) throw Error("search-vote iterations", "must be >= 0");
-  if (p.patch_match_iters < -1) throw Error("PatchMatch iterations", "must be >= 0");
-  if (p.search_radius < 0) throw Error("search radius", "must be >= 0 (0: the whole exemplar)");
-  if (!std::isfinite(p.style_weight)) throw Error("style weight", "must be finite");
+    throw Error(F{"pyramid_levels"}, fmt::format("must be >= 1 (got {})", p.pyramid_levels));
+  if (p.search_vote_iters < -1) throw Error(F{"search_vote_iters"}, "must be >= 0");
+  if (p.patch_match_iters < -1) throw Error(F{"patch_match_iters"}, "must be >= 0");
+  if (p.search_radius < 0) throw Error(F{"search_radius"}, "must be >= 0 (0: the whole exemplar)");
+  if (!std::isfinite(p.style_weight)) throw Error(F{"style_weight"}, "must be finite");
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
   const int ns = plane_channels(in.style);
@@ -161,7 +162,7 @@ void validate(const Inputs& in, const Params& p) {
       throw Error(g.name, fmt::format("a guide must have 1 to 4 channels (has {})", cs));
     if (!(g.weight < 0.0f || std::isfinite(g.weight)))
       throw Error(g.name, "weight must be a finite number >= 0");
-    check_finite(g.source, g.name);
+    check_finite(g.source, g.source_name.empty() ? g.name : g.source_name);
     check_finite(g.target, g.name);
   }
   if (sw < p.patch_size || sh < p.patch_size)
@@ -459,6 +460,8 @@ struct Solve {
   const Plane& input_style;  // the finest level votes from the input itself
   int border;
   PatchSsdFn ssd;
+  // Cancellation (Params::cancel), polled on this thread before each level and each sweep.
+  std::function<void()> poll;
   Image<int32_t> nnf;
   Image<float> err;
   Image<float> style;
@@ -508,6 +511,7 @@ struct Solve {
     cfg.uniformity = uniformity;
     cfg.iterations = sch.patch_match_iters;
     cfg.max_search_radius = sch.max_search_radius;
+    cfg.before_sweep = &poll;
     for (int it = 0; it < sch.search_vote_iters; ++it) {
       cfg.seed = hash_key(params.seed, uint64_t(step), uint64_t(it), uint64_t(patch));
       compute_errors(pm, cfg);
@@ -568,9 +572,13 @@ Result Synthesizer::run(const OutputRequest& request) {
   // so that the caller has already freed the guide images.
   build_coarse_levels(pyr, st.style, st.sw, st.sh, st.layout, st.border);
 
-  Solve solve{params, st.layout, st.style, st.border, best_patch_ssd(), {}, {}, {}};
+  Solve solve{params, st.layout, st.style, st.border, best_patch_ssd(), {}, {}, {}, {}};
+  solve.poll = [&params] {
+    if (params.cancel && params.cancel()) throw Cancelled();
+  };
   for (int l = levels - 1; l >= 0; --l) {
     Level& L = pyr[l];
+    solve.poll();
     if (params.progress) params.progress(levels - 1 - l, levels);
     solve.start_level(L, l, l == levels - 1);
     solve.search_and_vote(L, l, levels - 1 - l, schedule[levels - 1 - l], p, params.uniformity);

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -96,6 +97,15 @@ struct Params {
   uint64_t seed = 1;
   // Optional progress callback: (level, levels).
   std::function<void(int, int)> progress;
+  // Optional cancellation hook, polled on the calling thread before each level and each
+  // PatchMatch sweep. Returning true stops the run with synth::Cancelled; returning false
+  // changes nothing (results are those of a run without the hook).
+  std::function<bool()> cancel;
+};
+
+// Thrown by Synthesizer::run when Params::cancel asked to stop.
+struct Cancelled : std::exception {
+  const char* what() const noexcept override { return "synthesis cancelled"; }
 };
 
 struct Inputs {

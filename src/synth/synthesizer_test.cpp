@@ -199,6 +199,41 @@ TEST(Synthesize, FloatGuidesKeepThousandthSteps) {
   EXPECT_GT(double(exact) / total, 0.99);
 }
 
+TEST(Cancel, AHookThatNeverFiresChangesNothing) {
+  Fixture f;
+  f.style = noise(64, 48, 3, 4);
+  f.guide_src = textured(64, 48, 5);
+  f.guide_tgt = textured(72, 40, 6);
+  Params plain, hooked;
+  int polls = 0;
+  hooked.cancel = [&polls] { return ++polls < 0; };
+  EXPECT_TRUE(same_bits(synthesize(f.inputs(), plain).image, synthesize(f.inputs(), hooked).image));
+  EXPECT_GT(polls, 10);  // polled at every level and sweep
+}
+
+TEST(Cancel, StopsTheRunWithCancelled) {
+  Fixture f;
+  f.style = noise(64, 48, 3, 4);
+  f.guide_src = textured(64, 48, 5);
+  f.guide_tgt = textured(72, 40, 6);
+  Params params;
+  int polls = 0;
+  params.cancel = [&polls] { return ++polls == 5; };
+  EXPECT_THROW(synthesize(f.inputs(), params), Cancelled);
+  EXPECT_EQ(polls, 5);  // not polled again once it said stop
+}
+
+TEST(Synthesize, ScopedThreadCountGivesTheSameResult) {
+  Fixture f;
+  f.style = noise(64, 48, 3, 4);
+  f.guide_src = textured(64, 48, 5);
+  f.guide_tgt = textured(72, 40, 6);
+  const Result all = synthesize(f.inputs(), Params());
+  ScopedThreadCount one(1);
+  EXPECT_EQ(thread_count(), 1);
+  EXPECT_TRUE(same_bits(all.image, synthesize(f.inputs(), Params()).image));
+}
+
 TEST(Validate, RejectsBadInputsNamingThem) {
   Fixture f;
   f.style = noise(32, 32, 3, 1);
@@ -218,6 +253,21 @@ TEST(Validate, RejectsBadInputsNamingThem) {
   } catch (const Error& e) {
     EXPECT_EQ(e.subject(), "guide");
   }
+  in.guides[0].source_name = "guide source";
+  try {
+    validate(in, p);
+    FAIL() << "size mismatch accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.subject(), "guide source");
+  }
+  p.patch_size = 4;
+  try {
+    validate(f.inputs(), p);
+    FAIL() << "even patch size accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "patch_size");
+  }
+  p.patch_size = 5;
   Image<float> nan = noise(32, 32, 1, 4);
   nan(3, 4) = std::numeric_limits<float>::quiet_NaN();
   in = f.inputs();

@@ -9,7 +9,9 @@
 #   blender -b -P tools/blender/emaki_passes.py -- --gltf scene.glb --out DIR --frames 0-4
 #
 # `-- --help` lists every option. Installed as an add-on (Edit > Preferences > Add-ons >
-# Install... this file), it adds an "emaki" panel to the Output properties.
+# Install... this file, with emaki_stylize.py beside it: install a zip of the two), it adds an
+# "emaki" panel to the Output properties: render the passes of the frame range, and stylize the
+# current frame in Blender through emaki's Python module (emaki_stylize.py).
 #
 # How each pass is made (the README's "Studio renders" section has the conventions):
 #   normal, position, position_norm, rest_position, depth: a shader AOV written by a node group
@@ -774,33 +776,50 @@ def main(argv):
 # ---- add-on ----------------------------------------------------------------------------------
 
 
+def export_frames(context, out, first, last):
+    """Renders frames first..last of the open scene into `out` (frame_NNNN.exr) in a background
+    Blender on a copy of the file: the export rewires materials, lights, world and compositor,
+    and the open scene stays as it is. Returns None, or the error line."""
+    import subprocess
+    import tempfile
+    scene = context.scene
+    with tempfile.TemporaryDirectory() as tmp:
+        copy = os.path.join(tmp, "scene.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=copy, copy=True)
+        cmd = [bpy.app.binary_path, "-b", copy, "--scene", scene.name, "-P",
+               os.path.abspath(__file__), "--", "--out", out, "--frames",
+               "%d-%d" % (first, last), "--samples", str(scene.emaki_samples)]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode == 0:
+        return None
+    print(proc.stdout[-4000:], proc.stderr[-4000:])
+    lines = [l for l in proc.stderr.splitlines() if "emaki_passes: error" in l]
+    return lines[-1] if lines else "the export failed (see the console)"
+
+
 class EMAKI_OT_render_passes(bpy.types.Operator):
     bl_idname = "emaki.render_passes"
     bl_label = "Render emaki passes"
     bl_description = "Render the scene's frame range as emaki guide passes into the folder"
 
     def execute(self, context):
-        # The export rewires materials, lights, world and compositor: it runs in a background
-        # Blender on a copy of the file, so the open scene stays as it is.
-        import subprocess
-        import tempfile
         scene = context.scene
         out = bpy.path.abspath(scene.emaki_out)
-        with tempfile.TemporaryDirectory() as tmp:
-            copy = os.path.join(tmp, "scene.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=copy, copy=True)
-            cmd = [bpy.app.binary_path, "-b", copy, "--scene", scene.name, "-P",
-                   os.path.abspath(__file__), "--", "--out", out, "--frames",
-                   "%d-%d" % (scene.frame_start, scene.frame_end),
-                   "--samples", str(scene.emaki_samples)]
-            proc = subprocess.run(cmd, capture_output=True, text=True)
-        if proc.returncode != 0:
-            lines = [l for l in proc.stderr.splitlines() if "emaki_passes: error" in l]
-            self.report({"ERROR"}, lines[-1] if lines else "the export failed (see the console)")
-            print(proc.stdout[-4000:], proc.stderr[-4000:])
+        failure = export_frames(context, out, scene.frame_start, scene.frame_end)
+        if failure:
+            self.report({"ERROR"}, failure)
             return {"CANCELLED"}
         self.report({"INFO"}, "emaki passes written to %s" % out)
         return {"FINISHED"}
+
+
+def stylize_module():
+    """emaki_stylize.py, beside this file: the in-process stylization (emaki's Python module)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    if here not in sys.path:
+        sys.path.append(here)
+    import emaki_stylize
+    return emaki_stylize
 
 
 class EMAKI_PT_panel(bpy.types.Panel):
@@ -814,6 +833,7 @@ class EMAKI_PT_panel(bpy.types.Panel):
         col.prop(context.scene, "emaki_out")
         col.prop(context.scene, "emaki_samples")
         col.operator(EMAKI_OT_render_passes.bl_idname)
+        stylize_module().draw(self.layout, context.scene)
 
 
 def register():
@@ -821,11 +841,13 @@ def register():
                                                          default="//emaki_passes/")
     bpy.types.Scene.emaki_samples = bpy.props.IntProperty(name="Samples", default=16, min=1)
     bpy.utils.register_class(EMAKI_OT_render_passes)
+    stylize_module().register()
     bpy.utils.register_class(EMAKI_PT_panel)
 
 
 def unregister():
     bpy.utils.unregister_class(EMAKI_PT_panel)
+    stylize_module().unregister()
     bpy.utils.unregister_class(EMAKI_OT_render_passes)
     del bpy.types.Scene.emaki_out
     del bpy.types.Scene.emaki_samples

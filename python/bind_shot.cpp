@@ -1,0 +1,274 @@
+// emaki.Shot: the shot API (src/shot/shot.h, src/shot/plan.h) from Python — the same calls the
+// command line and the farm submitter make, not a copy of them.
+#include <fmt/format.h>
+#include <pybind11/eval.h>
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "python/bindings.h"
+#include "python/errors.h"
+#include "shot/plan.h"
+#include "shot/shot.h"
+
+namespace emaki::python {
+namespace {
+
+// Shot errors name shot-file keys (their own spelling); a Request's neutral fields become the
+// keyword arguments of the call.
+constexpr std::initializer_list<FieldName> kShotArgs = {{"frames", "frames"},
+                                                        {"layers", "layers"},
+                                                        {"layer", "layer"},
+                                                        {"chunk", "chunk"},
+                                                        {"threads", "threads"}};
+
+// Thrown out of the pipeline's progress hook to stop a run: Ctrl-C, or the callback raised.
+struct Stop {};
+
+class PyShot {
+ public:
+  explicit PyShot(pipeline::Shot shot) : shot_(std::move(shot)) {}
+
+  static PyShot load(const std::string& path) {
+    return PyShot(translating(ErrorKind::kFile, {}, [&] { return shot::open(path); }));
+  }
+  static PyShot from_toml(const std::string& text, const std::string& path) {
+    return PyShot(translating(ErrorKind::kInput, {}, [&] { return shot::open_text(text, path); }));
+  }
+
+  const pipeline::Shot& shot() const { return shot_; }
+
+  py::dict run(const py::object& frames, const py::object& layers, bool force, bool previews,
+               const py::object& threads, const py::object& progress) {
+    shot::Request r = request(frames, threads);
+    r.layers =
+        layers.is_none() ? std::vector<std::string>{} : layers.cast<std::vector<std::string>>();
+    r.force = force;
+    r.previews = previews;
+    PendingError pending;
+    bool stopped = false;
+    // The GIL is taken back for a moment at each layer-frame: Ctrl-C and the callback.
+    r.progress = [&](const pipeline::Progress& p) {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        pending.fetch();
+        stopped = true;
+        throw Stop();
+      }
+      if (progress.is_none()) return;
+      py::dict d;
+      d["frame"] = p.frame;
+      d["layer"] = p.layer.empty() ? py::none() : py::object(py::str(p.layer));
+      d["done"] = p.done;
+      d["total"] = p.total;
+      d["elapsed"] = p.elapsed_s;
+      if (PyObject_CallFunctionObjArgs(progress.ptr(), d.ptr(), nullptr) == nullptr) {
+        pending.fetch();
+        stopped = true;
+        throw Stop();
+      }
+    };
+    std::optional<shot::RunResult> res;
+    try {
+      res = without_gil(ErrorKind::kInput, kShotArgs, [&] { return shot::run(shot_, r); });
+    } catch (const Stop&) {
+    }
+    if (stopped) pending.raise();
+    py::dict out;
+    out["synthesized"] = res->report.synthesized;
+    out["reused"] = res->report.reused;
+    out["composited"] = res->report.composited;
+    out["frames"] = py::make_tuple(res->report.first_frame, res->report.last_frame);
+    out["previews"] = res->previews;
+    return out;
+  }
+
+  int composite(const py::object& frames, bool previews, const py::object& threads) {
+    shot::Request r = request(frames, threads);
+    r.previews = previews;
+    return without_gil(ErrorKind::kInput, kShotArgs,
+                       [&] { return shot::composite(shot_, r).composited; });
+  }
+
+  py::dict flicker(const std::string& layer, const py::object& frames) {
+    const shot::Request r = request(frames, py::none());
+    const shot::FlickerResult f =
+        without_gil(ErrorKind::kInput, kShotArgs, [&] { return shot::flicker(shot_, layer, r); });
+    py::list per_frame;
+    for (const pipeline::FrameFlicker& ff : f.frames)
+      per_frame.append(py::dict(py::arg("frame") = ff.frame, py::arg("all") = ff.all.mean(),
+                                py::arg("objects") = ff.objects.mean(),
+                                py::arg("ground") = ff.ground.mean()));
+    return py::dict(py::arg("layer") = layer,
+                    py::arg("frames") = py::make_tuple(f.first_frame, f.last_frame),
+                    py::arg("mean") = f.mean.all.mean(), py::arg("objects") = f.mean.objects.mean(),
+                    py::arg("ground") = f.mean.ground.mean(), py::arg("per_frame") = per_frame);
+  }
+
+  py::object plan(int chunk, int threads, const std::string& emaki) {
+    shot::PlanOptions o;
+    o.chunk = chunk;
+    o.threads = threads;
+    o.emaki = emaki;
+    const std::string json = translating(ErrorKind::kInput, kShotArgs, [&] {
+      return shot::plan_json(shot::plan({{"", shot_.path, shot_}}, o));
+    });
+    return py::module_::import("json").attr("loads")(json);
+  }
+
+ private:
+  shot::Request request(const py::object& frames, const py::object& threads) const {
+    shot::Request r;
+    if (py::isinstance<py::int_>(frames)) {
+      r.first_frame = r.last_frame = frames.cast<int>();
+    } else if (!frames.is_none()) {
+      const auto ab = frames.cast<std::vector<int>>();
+      if (ab.size() != 2) raise_input_error("frames", "expected a frame or (first, last)");
+      r.first_frame = ab[0], r.last_frame = ab[1];
+    }
+    if (r.first_frame < -1 || r.last_frame < -1) raise_input_error("frames", "frames must be >= 0");
+    if (!threads.is_none()) {
+      r.threads = threads.cast<int>();
+      if (r.threads < 0 || r.threads > 1024) raise_input_error("threads", "must be in [0, 1024]");
+    }
+    return r;
+  }
+
+  pipeline::Shot shot_;
+};
+
+constexpr const char* kShotDoc = R"(A shot: its file's settings, checked (docs/shot_file.md).
+
+Shot.load(path)            the shot file (TOML); relative paths are the file's folder's
+Shot.from_dict(d, path)    the same settings as nested dicts (keys as in the file)
+shot.run(...)              synthesize, composite and write (as `emaki run`)
+shot.composite(...)        re-colour finished layers (as `emaki composite`)
+shot.flicker(layer, ...)   temporal error of a finished layer (as `emaki qa flicker`)
+shot.plan(...)             the render-farm task graph (as `emaki plan --json`)
+
+Errors: emaki.InputError whose `subject` is the shot file's key ("layers.base.opacity") or the
+argument ("frames", "layers", "layer"); emaki.FileError for a file that cannot be read.)";
+
+// Shot.from_dict: the dict written as the TOML the shot file would hold, then parsed by the same
+// parser (so a bad key is named by its key path exactly as in a file).
+constexpr const char* kFromDict = R"(
+import json as _json
+import re as _re
+
+
+def _toml_key(k):
+    if not isinstance(k, str):
+        raise TypeError(f"shot keys must be strings, got {k!r}")
+    return k if _re.fullmatch(r"[A-Za-z0-9_-]+", k) else _json.dumps(k)
+
+
+def _toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)  # inf and nan are TOML too (the parser refuses them with the key)
+    if isinstance(v, str):
+        return _json.dumps(v)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{_toml_key(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
+    if hasattr(v, "item"):  # a numpy scalar
+        return _toml_value(v.item())
+    raise TypeError(f"a shot value must be a bool, number, string, list or dict, got {type(v).__name__}")
+
+
+def _toml_table(d, prefix, lines):
+    scalars = [(k, v) for k, v in d.items() if not isinstance(v, dict)]
+    tables = [(k, v) for k, v in d.items() if isinstance(v, dict)]
+    if prefix and (scalars or not tables):
+        lines.append(f"[{prefix}]")
+    for k, v in scalars:
+        lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+    for k, v in tables:
+        _toml_table(v, f"{prefix}.{_toml_key(k)}" if prefix else _toml_key(k), lines)
+
+
+def from_dict(d, path="shot.toml"):
+    """from_dict(d: dict, path: str = "shot.toml") -> Shot
+
+    A shot from nested dicts with the shot file's keys (docs/shot_file.md), e.g.
+    {"source": {"scene": "Fox.glb", "frames": [0, 47], "size": [960, 540]}, ...}. Relative
+    paths are resolved against path's folder (the current folder by default); errors name the
+    key path as for a file."""
+    if not isinstance(d, dict):
+        raise TypeError("from_dict expects a dict")
+    lines = []
+    _toml_table(d, "", lines)
+    return Shot._from_toml("\n".join(lines) + "\n", path)
+)";
+
+}  // namespace
+
+void bind_shot(py::module_& m) {
+  py::class_<PyShot>(m, "Shot", kShotDoc)
+      .def_static("load", &PyShot::load, py::arg("path"),
+                  "load(path: str) -> Shot\n\nReads and checks a shot file; writes nothing.")
+      .def_static("_from_toml", &PyShot::from_toml, py::arg("text"), py::arg("path"))
+      .def_property_readonly("path", [](const PyShot& s) { return s.shot().path; })
+      .def_property_readonly("frames",
+                             [](const PyShot& s) {
+                               return py::make_tuple(s.shot().source.first_frame,
+                                                     s.shot().source.last_frame);
+                             })
+      .def_property_readonly("size",
+                             [](const PyShot& s) {
+                               return py::make_tuple(s.shot().source.width, s.shot().source.height);
+                             })
+      .def_property_readonly("layers",
+                             [](const PyShot& s) {
+                               std::vector<std::string> names;
+                               for (const auto& l : s.shot().layers) names.push_back(l.name);
+                               return names;
+                             })
+      .def_property_readonly("output_folder",
+                             [](const PyShot& s) { return s.shot().outputs.folder; })
+      .def("run", &PyShot::run, py::kw_only(), py::arg("frames") = py::none(),
+           py::arg("layers") = py::none(), py::arg("force") = false, py::arg("previews") = true,
+           py::arg("threads") = py::none(), py::arg("progress") = py::none(),
+           "run(*, frames=None, layers=None, force=False, previews=True, threads=None, "
+           "progress=None) -> dict\n\n"
+           "Synthesizes every layer of the requested frames (with the temporal chain), composites "
+           "them and writes the shot's outputs; resumes after the last finished frame.\n"
+           "frames: None (all), a frame, or (first, last) inclusive, within the shot's frames.\n"
+           "layers: None (all) or a list of layer names.  force: redo finished frames.\n"
+           "previews: write the contact sheet and MP4.  threads: None (the shot's), 0 = all "
+           "cores, [0, 1024].\nprogress: called with {frame, layer, done, total, elapsed} before "
+           "each layer-frame (layer None: compositing); raising from it stops the run.\n"
+           "The GIL is released while it runs; Ctrl-C stops it after the current layer-frame.\n"
+           "Returns {synthesized, reused, composited, frames, previews}.")
+      .def("composite", &PyShot::composite, py::kw_only(), py::arg("frames") = py::none(),
+           py::arg("previews") = true, py::arg("threads") = py::none(),
+           "composite(*, frames=None, previews=True, threads=None) -> int\n\n"
+           "Re-composites finished layers with the shot's colours, blends and paper; returns the "
+           "frames written.")
+      .def("flicker", &PyShot::flicker, py::arg("layer"), py::kw_only(),
+           py::arg("frames") = py::none(),
+           "flicker(layer, *, frames=None) -> dict\n\nTemporal error of a finished layer over at "
+           "least two frames: {layer, frames, mean, objects, ground, per_frame}.")
+      .def("plan", &PyShot::plan, py::kw_only(), py::arg("chunk") = 8, py::arg("threads") = 1,
+           py::arg("emaki") = "emaki",
+           "plan(*, chunk=8, threads=1, emaki='emaki') -> dict\n\nThe render-farm task graph "
+           "(docs/farm.md): chunk frames per chunked task, [1, 1000000]; threads per task; emaki "
+           "the binary the tasks run.");
+  py::dict scope;
+  scope["__builtins__"] = py::module_::import("builtins");
+  scope["Shot"] = m.attr("Shot");
+  py::exec(kFromDict, scope);
+  m.attr("Shot").attr("from_dict") =
+      py::module_::import("builtins").attr("staticmethod")(scope["from_dict"]);
+}
+
+}  // namespace emaki::python

@@ -1,0 +1,29 @@
+// The `emaki` Python module: the engine over numpy arrays, image files, the guide-pass
+// renderer and the reference sphere. Everything runs the same C++ code as the command line.
+#include <pybind11/pybind11.h>
+
+#include "python/bindings.h"
+#include "python/errors.h"
+
+PYBIND11_MODULE(emaki, m) {
+  using namespace emaki::python;
+  m.doc() =
+      "emaki: stylize 3D animation by example.\n\n"
+      "synthesize()  guided patch-based synthesis over numpy arrays (as `emaki synth`)\n"
+      "read_image(), write_image(), image_channels()  image files (PNG, EXR by channel "
+      "name, TIFF, JPEG)\n"
+      "render()  guide passes of a glTF scene at one frame (as `emaki render`)\n"
+      "template()  the reference sphere's passes and paint template (as `emaki template`)\n"
+      "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
+      "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
+  m.attr("__version__") = "0.1.0";
+  // Each docstring starts with its own signature (Python types, as in emaki.pyi) instead of
+  // pybind11's, which would show C++ handle types.
+  py::options options;
+  options.disable_function_signatures();
+  bind_errors(m);
+  bind_synth(m);
+  bind_images(m);
+  bind_render(m);
+  bind_shot(m);
+}
