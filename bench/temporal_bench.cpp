@@ -1,13 +1,14 @@
-// Temporal noise reduction on the bundled example (examples/fox/shot.toml): one layer run
-// frame by frame and with advection by `position` (the paper's) or `rest_position`, each with or
+// Temporal noise reduction on a bundled example (examples/fox/shot.toml, or --shot): one layer
+// run frame by frame and with advection by `position` (the paper's) or `rest_position`, each with or
 // without the advection's confidence as the temporal guide's weight map, compared on flicker
-// (`emaki qa flicker`'s measure, split into the walking Fox and the static ground), on ghosts
+// (`emaki qa flicker`'s measure, split into the scene's objects and the static ground, then per
+// object id), on ghosts
 // (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with --judge, on the
 // independent judge's `style` energy of sampled frames (is the output still made of exemplar
 // texture?). Frames stay in memory; nothing is written except the judge's inputs and, with
 // --save, the variants' layer frames as PNGs.
 //
-//   temporal_bench [--size 960x540] [--frames 48] [--layer base]
+//   temporal_bench [--shot SHOT.toml] [--size WxH (the shot's)] [--frames 48] [--layer base]
 //                  [--variants frame,rest_position_noconf_uniform@1,rest_position,...]
 //                  [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N]
 //                  [--temporal-weight W]
@@ -56,7 +57,8 @@ const std::vector<std::string> kVariants = {"frame", "position", "rest_position"
                                             "rest_position_noconf"};
 
 struct Options {
-  int width = 960, height = 540, frames = 48, threads = 0, judge_every = 8;
+  int width = 0, height = 0, frames = 48, threads = 0, judge_every = 8;  // size 0: the shot's
+  std::string shot = std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml";
   std::string layer = "base", judge, judge_dir = "/tmp/emaki_temporal_judge", save;
   std::vector<std::string> variants = {"frame", "rest_position_noconf_uniform@1",
                                        "rest_position_uniform", "position", "rest_position"};
@@ -67,7 +69,7 @@ struct Options {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(
       stderr,
-      "temporal_bench: %s\nusage: temporal_bench [--size WxH] [--frames N] [--layer NAME] "
+      "temporal_bench: %s\nusage: temporal_bench [--shot SHOT] [--size WxH] [--frames N] [--layer NAME] "
       "[--variants a,b,...] [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N] "
       "[--temporal-weight W] [--judge PATH] "
       "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",
@@ -104,7 +106,9 @@ Options parse(int argc, char** argv) {
     const std::string a = argv[i];
     if (i + 1 >= argc) usage("missing value after " + a);
     const std::string v = argv[++i];
-    if (a == "--size") {
+    if (a == "--shot") {
+      o.shot = v;
+    } else if (a == "--size") {
       if (std::sscanf(v.c_str(), "%dx%d", &o.width, &o.height) != 2) usage("bad --size " + v);
     } else if (a == "--frames") {
       o.frames = std::max(2, std::atoi(v.c_str()));
@@ -191,6 +195,27 @@ struct Variant {
   double style_sum = 0.0;
 };
 
+// Flicker per object id (rows) and variant (columns), and each variant against the first.
+void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& variants) {
+  std::printf("\n%-4s %-24s", "id", "object");
+  for (const Variant& v : variants) std::printf(" %14s", v.name.c_str());
+  std::printf("\n");
+  for (const auto& [id, first] : variants[0].flicker.by_id) {
+    std::string name = id == 1 ? "ground" : "object";
+    for (std::size_t i = 0; i < shot.source.objects.size(); ++i)
+      if (shot.source.objects[i].id == id)
+        name = fmt::format("objects[{}] {}", i,
+                           std::filesystem::path(shot.source.objects[i].scene).stem().string());
+    std::printf("%-4d %-24s", id, name.c_str());
+    for (const Variant& v : variants) {
+      const auto it = v.flicker.by_id.find(id);
+      const double m = it == v.flicker.by_id.end() ? 0.0 : it->second.mean();
+      std::printf(" %7.5f %5.2fx", m, first.mean() > 0 ? m / first.mean() : 0.0);
+    }
+    std::printf("\n");
+  }
+}
+
 pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, const Options& o) {
   const std::size_t at = variant.find('@');
   const std::string name = base_name(variant);
@@ -207,9 +232,11 @@ pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, con
 
 // The example at the bench's size and length, with `layer` found in it.
 pipeline::Shot example(const Options& opt, pipeline::Layer*& layer) {
-  pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
-  shot.source.width = shot.source.render.width = opt.width;
-  shot.source.height = shot.source.render.height = opt.height;
+  pipeline::Shot shot = shot::open(opt.shot);
+  if (opt.width > 0) {
+    shot.source.width = shot.source.render.width = opt.width;
+    shot.source.height = shot.source.render.height = opt.height;
+  }
   shot.source.last_frame = shot.source.first_frame + opt.frames - 1;
   shot.source.shot.last_frame = shot.source.last_frame;
   layer = nullptr;
@@ -352,6 +379,7 @@ int main(int argc, char** argv) {
       prev_passes = std::move(passes);
     }
     print_table(variants, opt, first, last, judged);
+    print_objects(shot, variants);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "temporal_bench: %s\n", e.what());
     return 1;
