@@ -1,6 +1,6 @@
 // Temporal noise reduction on a bundled example (examples/fox/shot.toml, or --shot): one layer
-// run frame by frame and with advection by `position` (the paper's) or `rest_position`, each with or
-// without the advection's confidence as the temporal guide's weight map, compared on flicker
+// run frame by frame and with advection by `position` (the paper's) or `rest_position`, each with
+// or without the advection's confidence as the temporal guide's weight map, compared on flicker
 // (`emaki qa flicker`'s measure, split into the scene's objects and the static ground, then per
 // object id), on ghosts
 // (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with --judge, on the
@@ -69,7 +69,8 @@ struct Options {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(
       stderr,
-      "temporal_bench: %s\nusage: temporal_bench [--shot SHOT] [--size WxH] [--frames N] [--layer NAME] "
+      "temporal_bench: %s\nusage: temporal_bench [--shot SHOT] [--size WxH] [--frames N] [--layer "
+      "NAME] "
       "[--variants a,b,...] [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N] "
       "[--temporal-weight W] [--judge PATH] "
       "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",

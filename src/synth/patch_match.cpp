@@ -331,4 +331,41 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   }
 }
 
+// ---- starting fields ----
+
+Image<int32_t> upscale_nnf(const Image<int32_t>& coarse, int tw, int th, int sw, int sh, int r) {
+  Image<int32_t> out(tw, th, 2);
+  parallel_rows(th, 64, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < tw; ++x) {
+        const int32_t* m =
+            coarse.at(std::min(x / 2, coarse.width() - 1), std::min(y / 2, coarse.height() - 1));
+        out(x, y, 0) = std::clamp(2 * m[0] + (x & 1), r, sw - r - 1);
+        out(x, y, 1) = std::clamp(2 * m[1] + (y & 1), r, sh - r - 1);
+      }
+  });
+  return out;
+}
+
+Image<int32_t> identity_nnf(int tw, int th, int sw, int sh, int r) {
+  Image<int32_t> out(tw, th, 2);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      out(x, y, 0) = std::clamp(int((int64_t(x) * sw) / tw), r, sw - 1 - r);
+      out(x, y, 1) = std::clamp(int((int64_t(y) * sh) / th), r, sh - 1 - r);
+    }
+  return out;
+}
+
+Image<int32_t> random_nnf(int tw, int th, int sw, int sh, int r, uint64_t seed) {
+  Image<int32_t> out(tw, th, 2);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      CounterRng rng(hash_key(seed, 0x1417, uint64_t(y) * 65536u + uint64_t(x)));
+      out(x, y, 0) = r + int(rng.uniform(uint32_t(sw - 2 * r)));
+      out(x, y, 1) = r + int(rng.uniform(uint32_t(sh - 2 * r)));
+    }
+  return out;
+}
+
 }  // namespace emaki::synth

@@ -80,6 +80,13 @@ inline int64_t patch_distance(const PatchMatchLevel& L, const PatchMatchConfig& 
                        C.groups);
 }
 
+// Starting fields (tw x th, 2 channels: source patch centre x, y, kept r from the source's
+// border): the coarser level's field doubled, the identity scaled to the source, or uniform
+// random draws keyed by `seed` and the pixel (independent of the thread count).
+Image<int32_t> upscale_nnf(const Image<int32_t>& coarse, int tw, int th, int sw, int sh, int r);
+Image<int32_t> identity_nnf(int tw, int th, int sw, int sh, int r);
+Image<int32_t> random_nnf(int tw, int th, int sw, int sh, int r, uint64_t seed);
+
 // Patch error of every active target pixel against its current match, in EbSynth units.
 void compute_errors(const PatchMatchLevel& level, const PatchMatchConfig& config);
 
