@@ -141,5 +141,16 @@ TEST(ShotFile, ErrorsNameALongPathWhole) {
   expect_errors({{text, "source.sequence: no such file '" + folder + "/frame_0000.exr'"}});
 }
 
+// A path over 400 bytes is shown by its head and tail: still one short line ending in the file.
+TEST(ShotFile, ErrorsNameAVeryLongPathByItsEnds) {
+  const std::string folder = "/nonexistent/" + std::string(1000, 'd');
+  std::string text = minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n");
+  const std::size_t from = text.find("scene = "), to = text.find("size = [64, 48]\n");
+  text.replace(from, to + 16 - from,
+               "sequence = \"" + folder + "/frame_%04d.exr\"\nframes = [0, 3]\n");
+  expect_errors({{text, "source.sequence: no such file '/nonexistent/ddd",
+                  "...(1028 bytes)..." + std::string(265, 'd') + "/frame_0000.exr' (frame 0)"}});
+}
+
 }  // namespace
 }  // namespace emaki::shot
