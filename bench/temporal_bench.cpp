@@ -11,14 +11,15 @@
 //   temporal_bench [--shot SHOT.toml] [--size WxH (the shot's)] [--frames 48] [--layer base]
 //                  [--variants frame,rest_position_noconf_uniform@1,rest_position,...]
 //                  [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N]
-//                  [--temporal-weight W]
+//                  [--temporal-weight W] [--temporal-uniformity U]
 //                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--save DIR]
 //                  [--threads N]
 //
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
 // `rest_position_noconf` (temporal_confidence = false); a `_uniform` suffix keeps the layer's
-// uniformity at temporal frames (temporal_uniformity = uniformity), @W gives the variant the
+// uniformity at temporal frames (temporal_uniformity = uniformity, or --temporal-uniformity U),
+// @W gives the variant the
 // temporal weight W (`rest_position_noconf_uniform@1`: the example before the confidence).
 // --error-*, --foreign-none and --erode set the confidence's parameters
 // (temporal::ConfidenceParams), --temporal-weight the temporal weight of every temporal variant
@@ -63,7 +64,8 @@ struct Options {
   std::vector<std::string> variants = {"frame", "rest_position_noconf_uniform@1",
                                        "rest_position_uniform", "position", "rest_position"};
   temporal::ConfidenceParams confidence;
-  float temporal_weight = -1.0f;  // -1: the example's
+  float temporal_weight = -1.0f;      // -1: the example's
+  float temporal_uniformity = -1.0f;  // for `_uniform` variants; -1: the layer's uniformity
 };
 
 [[noreturn]] void usage(const std::string& why) {
@@ -72,7 +74,7 @@ struct Options {
       "temporal_bench: %s\nusage: temporal_bench [--shot SHOT] [--size WxH] [--frames N] [--layer "
       "NAME] "
       "[--variants a,b,...] [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N] "
-      "[--temporal-weight W] [--judge PATH] "
+      "[--temporal-weight W] [--temporal-uniformity U] [--judge PATH] "
       "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",
       why.c_str());
   std::exit(2);
@@ -127,6 +129,8 @@ Options parse(int argc, char** argv) {
       o.confidence.erode = std::atoi(v.c_str());
     } else if (a == "--temporal-weight") {
       o.temporal_weight = std::strtof(v.c_str(), nullptr);
+    } else if (a == "--temporal-uniformity") {
+      o.temporal_uniformity = std::strtof(v.c_str(), nullptr);
     } else if (a == "--judge") {
       o.judge = v;
     } else if (a == "--judge-every") {
@@ -161,17 +165,28 @@ Image<float> judge_guide(const Image<float>& pass, const std::string& name) {
   return out;
 }
 
-double run_judge(const std::string& cmd) {
+// The judge's figures this bench reports: `style` (is B' made of exemplar texture?) and
+// `coverage` (how much of the exemplar it uses): a temporal chain that washes out to blank
+// paper scores a low style energy, and only its coverage shows it.
+struct JudgeFigures {
+  double style = 0.0, coverage = 0.0;
+};
+
+double json_number(const std::string& out, const std::string& key) {
+  std::smatch m;
+  if (!std::regex_search(out, m, std::regex("\"" + key + "\"\\s*:\\s*([0-9.eE+-]+)")))
+    throw std::runtime_error("no " + key + " in the judge's output: " + out);
+  return std::stod(m[1]);
+}
+
+JudgeFigures run_judge(const std::string& cmd) {
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) throw std::runtime_error("cannot run " + cmd);
   std::string out;
   char buf[4096];
   while (std::fgets(buf, sizeof buf, p)) out += buf;
   if (pclose(p) != 0) throw std::runtime_error("judge failed: " + cmd + "\n" + out);
-  std::smatch m;
-  if (!std::regex_search(out, m, std::regex("\"style\"\\s*:\\s*([0-9.eE+-]+)")))
-    throw std::runtime_error("no style energy in the judge's output: " + out);
-  return std::stod(m[1]);
+  return {json_number(out, "style"), json_number(out, "coverage")};
 }
 
 // The layer's value over white outside its mask: what the judge and --save see.
@@ -193,7 +208,7 @@ struct Variant {
   double seconds = 0.0;
   pipeline::SequenceFlicker flicker;
   pipeline::GhostStats ghost;
-  double style_sum = 0.0;
+  double style_sum = 0.0, coverage_sum = 0.0;
 };
 
 // Flicker per object id (rows) and variant (columns), and each variant against the first.
@@ -227,7 +242,9 @@ pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, con
   l.temporal.confidence_params = o.confidence;
   if (o.temporal_weight >= 0.0f) l.temporal.weight = o.temporal_weight;
   if (at != std::string::npos) l.temporal.weight = std::strtof(variant.c_str() + at + 1, nullptr);
-  if (variant.find("_uniform") != std::string::npos) l.temporal.uniformity = l.synth.uniformity;
+  if (variant.find("_uniform") != std::string::npos)
+    l.temporal.uniformity =
+        o.temporal_uniformity >= 0.0f ? o.temporal_uniformity : l.synth.uniformity;
   return l;
 }
 
@@ -294,9 +311,11 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
   for (Variant& v : variants) {
     const std::string path = fmt::format("{}/{}_{:04d}.png", opt.judge_dir, v.name, f);
     write_png(path, on_white(v.store.read_layer(layer, f), n));
-    const double s = run_judge(fixed + guides + fmt::format(" -output-to-judge '{}'", path));
-    std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f\n", f, v.name.c_str(), s);
-    v.style_sum += s;
+    const JudgeFigures j = run_judge(fixed + guides + fmt::format(" -output-to-judge '{}'", path));
+    std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f coverage %.4f\n", f,
+                 v.name.c_str(), j.style, j.coverage);
+    v.style_sum += j.style;
+    v.coverage_sum += j.coverage;
   }
 }
 
@@ -325,8 +344,9 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
   std::printf("temporal_bench: layer '%s', %dx%d, frames %d-%d, %d threads%s\n", opt.layer.c_str(),
               opt.width, opt.height, first, last, thread_count(),
               judged ? fmt::format(", judge on {} frames", judged).c_str() : "");
-  std::printf("%-24s %8s %9s %9s %9s %9s %12s %9s %9s %9s\n", "variant", "s/frame", "flicker",
-              "fox", "ground", "vs frame", "judge style", "ghost", "diff hid", "diff vis");
+  std::printf("%-24s %8s %9s %9s %9s %9s %12s %9s %9s %9s %9s\n", "variant", "s/frame", "flicker",
+              "fox", "ground", "vs frame", "judge style", "coverage", "ghost", "diff hid",
+              "diff vis");
   const Variant& base = variants[0];
   const bool ref = base.name == "frame";
   const double base_style = ref && judged ? base.style_sum / judged : 0.0;
@@ -339,10 +359,12 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
                                  : "")
                : "-";
     const bool ghosted = ref && v.layer.temporal.enabled;
-    std::printf("%-24s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s\n", v.name.c_str(),
+    const std::string coverage_text =
+        judged ? fmt::format("{:.4f}", v.coverage_sum / judged) : std::string("-");
+    std::printf("%-24s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s %9s\n", v.name.c_str(),
                 v.seconds / opt.frames, v.flicker.all.mean(), v.flicker.objects.mean(),
                 v.flicker.ground.mean(), ref ? v.flicker.all.mean() / base.flicker.all.mean() : 0.0,
-                style_text.c_str(),
+                style_text.c_str(), coverage_text.c_str(),
                 ghosted ? fmt::format("{:.4f}", v.ghost.ghost_share()).c_str() : "-",
                 ghosted ? fmt::format("{:.5f}", v.ghost.diff()).c_str() : "-",
                 ghosted ? fmt::format("{:.5f}", v.ghost.visible_diff()).c_str() : "-");
