@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <initializer_list>
-#include <memory>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -128,7 +127,6 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
     return;
   }
   make_folder(root);
-  writer_ = std::make_unique<BackgroundWriter>();
   // Before anything is cleaned up or written: another emaki's temporaries are not ours to remove.
   lock_ = std::make_unique<FolderLock>(paths_.folder, access == StoreAccess::kFarmTask
                                                           ? FolderLock::Kind::kShared
@@ -189,7 +187,6 @@ void FileStore::make_current(Manifested& m, const std::string& folder,
 
 void FileStore::prepare() {
   CHECK(mode_ == StoreMode::kRun);
-  flush();
   const fs::path root(paths_.folder);
   for (const pipeline::Layer& l : shot_.layers)
     make_current(layers_.at(l.name), (root / "layers" / l.name).string(),
@@ -220,7 +217,6 @@ bool FileStore::has_passes(int frame) const {
 
 void FileStore::write_passes(int frame, ImageView<const float> passes) {
   CHECK(access_ != StoreAccess::kInspect);
-  if (writer_) writer_->check();
   const fs::path dir = fs::path(paths_.folder) / "passes";
   make_folder(dir);
   make_current(passes_, dir.string(),
@@ -232,16 +228,6 @@ void FileStore::write_passes(int frame, ImageView<const float> passes) {
 }
 
 FileStore::~FileStore() = default;
-
-void FileStore::flush() {
-  if (writer_) writer_->wait();
-}
-
-bool FileStore::queued(const std::string& path) const {
-  if (!writer_) return false;
-  writer_->check();
-  return writer_->pending(path);
-}
 
 const FileStore::Manifested& FileStore::layer_state(const pipeline::Layer& layer) const {
   const auto it = layers_.find(layer.name);
@@ -258,7 +244,6 @@ bool FileStore::has_layer(const pipeline::Layer& layer, int frame) const {
                   fmt::format("was made with other settings ({}); {}", m.stale, kRedoHint));
     return false;
   }
-  if (queued(paths_.layer_exr(layer.name, frame))) return true;
   std::error_code ec;
   if (!fs::is_regular_file(paths_.layer_exr(layer.name, frame), ec)) return false;
   return !shot_.outputs.layer_png || fs::is_regular_file(paths_.layer_png(layer.name, frame), ec);
@@ -266,7 +251,6 @@ bool FileStore::has_layer(const pipeline::Layer& layer, int frame) const {
 
 Image<float> FileStore::read_layer(const pipeline::Layer& layer, int frame) const {
   const std::string path = paths_.layer_exr(layer.name, frame);
-  if (queued(path)) writer_->wait();
   Image<float> img = read_image_float(path);
   // The file is on disk, where anything may have replaced it: what the chain and the composite
   // index must match the shot.
@@ -286,35 +270,22 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
                  remove_frames(dir, layer.name + "_", {".png", ".exr"});
                });
   const int n = layer.single_colour ? 1 : 3;
-  auto image = std::make_shared<Image<float>>(value.width, value.height, value.channels);
-  for (int y = 0; y < value.height; ++y)
-    std::copy(value.row(y), value.row(y) + std::size_t(value.width) * value.channels,
-              image->row(y));
-  const std::string png_path = paths_.layer_png(layer.name, frame);
-  const std::string exr_path = paths_.layer_exr(layer.name, frame);
-  const bool png = shot_.outputs.layer_png;
-  writer_->submit({png_path, exr_path}, [=] {
-    // The PNG first: the EXR is what marks the frame finished, so it is written last.
-    if (png) {
-      WriteOptions po;
-      po.format = SampleFormat::kU16;
-      write_image(png_path, image->cview(), po);
-    }
-    WriteOptions exr;
-    exr.format =
-        SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
-    exr.channel_names = value_names("", image->channels(), n);
-    write_image(exr_path, image->cview(), exr);
-  });
+  // The PNG first: the EXR is what marks the frame finished, so it is written last.
+  if (shot_.outputs.layer_png) {
+    WriteOptions png;
+    png.format = SampleFormat::kU16;
+    write_image(paths_.layer_png(layer.name, frame), value, png);
+  }
+  WriteOptions exr;
+  exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
+  exr.channel_names = value_names("", value.channels, n);
+  write_image(paths_.layer_exr(layer.name, frame), value, exr);
 }
 
 bool FileStore::has_frame(int frame) const {
   if (!frames_.current) return false;
   std::error_code ec;
   const pipeline::Outputs& o = shot_.outputs;
-  if (queued(paths_.composite_png(frame)) || queued(paths_.composite_exr(frame)) ||
-      queued(paths_.layered_exr(frame)))
-    return true;
   if (o.composite_png && !fs::is_regular_file(paths_.composite_png(frame), ec)) return false;
   if (o.composite_exr && !fs::is_regular_file(paths_.composite_exr(frame), ec)) return false;
   if (o.layered_exr && !fs::is_regular_file(paths_.layered_exr(frame), ec)) return false;
@@ -332,14 +303,12 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
     remove_frames(root / "layered", "frame_", {".exr"});
   });
   // The composite without its (constant) alpha.
-  auto rgb = std::make_shared<Image<float>>(composite.width, composite.height, 3);
+  Image<float> rgb(composite.width, composite.height, 3);
   for (int y = 0; y < composite.height; ++y)
     for (int x = 0; x < composite.width; ++x)
-      for (int c = 0; c < 3; ++c) (*rgb)(x, y, c) = composite(x, y, c);
-  std::shared_ptr<Image<float>> all;
-  std::vector<std::string> names;
+      for (int c = 0; c < 3; ++c) rgb(x, y, c) = composite(x, y, c);
   if (o.layered_exr) {
-    names = render::channel_names();
+    std::vector<std::string> names = render::channel_names();
     int channels = passes.channels + 3;
     for (std::size_t i = 0; i < layers.size(); ++i) {
       // Prefixed: a layer may share its name with a pass ("shadow", "outline").
@@ -349,38 +318,31 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
       channels += layers[i].channels;
     }
     for (const char* c : {"composite.R", "composite.G", "composite.B"}) names.push_back(c);
-    all = std::make_shared<Image<float>>(passes.width, passes.height, channels);
+    Image<float> all(passes.width, passes.height, channels);
     for (int y = 0; y < passes.height; ++y)
       for (int x = 0; x < passes.width; ++x) {
-        float* d = all->at(x, y);
+        float* d = all.at(x, y);
         for (int c = 0; c < passes.channels; ++c) *d++ = passes(x, y, c);
         for (const auto& l : layers)
           for (int c = 0; c < l.channels; ++c) *d++ = l(x, y, c);
-        for (int c = 0; c < 3; ++c) *d++ = (*rgb)(x, y, c);
+        for (int c = 0; c < 3; ++c) *d++ = rgb(x, y, c);
       }
+    WriteOptions wo;
+    wo.format = SampleFormat::kHalf;
+    wo.channel_names = names;
+    write_image(paths_.layered_exr(frame), all.cview(), wo);
   }
-  const std::string layered_path = paths_.layered_exr(frame);
-  const std::string exr_path = paths_.composite_exr(frame), png_path = paths_.composite_png(frame);
-  const bool exr = o.composite_exr, png = o.composite_png;
-  writer_->submit({layered_path, exr_path, png_path}, [=] {
-    if (all) {
-      WriteOptions wo;
-      wo.format = SampleFormat::kHalf;
-      wo.channel_names = names;
-      write_image(layered_path, all->cview(), wo);
-    }
-    if (exr) {
-      WriteOptions wo;
-      wo.format = SampleFormat::kHalf;
-      write_image(exr_path, rgb->cview(), wo);
-    }
-    // The PNG last: with the default outputs it is what has_frame looks for first.
-    if (png) {
-      WriteOptions wo;
-      wo.format = SampleFormat::kU16;
-      write_image(png_path, rgb->cview(), wo);
-    }
-  });
+  if (o.composite_exr) {
+    WriteOptions wo;
+    wo.format = SampleFormat::kHalf;
+    write_image(paths_.composite_exr(frame), rgb.cview(), wo);
+  }
+  // The PNG last: with the default outputs it is what has_frame looks for first.
+  if (o.composite_png) {
+    WriteOptions wo;
+    wo.format = SampleFormat::kU16;
+    write_image(paths_.composite_png(frame), rgb.cview(), wo);
+  }
 }
 
 namespace {

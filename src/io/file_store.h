@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "io/background_writer.h"
 #include "io/output_store.h"
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
@@ -76,13 +75,9 @@ class FileStore : public pipeline::Store {
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
   bool has_frame(int frame) const override;
-  // Layer and frame files are encoded and written on a background thread, in order
-  // (io/background_writer.h): these return once the images are copied, a later call (or flush)
-  // reports a failed write, and the store's answers count a queued file as there.
   void write_frame(int frame, ImageView<const float> composite,
                    const std::vector<ImageView<const float>>& layers,
                    ImageView<const float> passes) override;
-  void flush() override;
   const OutputPaths& paths() const { return paths_; }
 
  private:
@@ -92,8 +87,6 @@ class FileStore : public pipeline::Store {
     std::string stale;     // !current and something is there: what changed
   };
   const Manifested& layer_state(const pipeline::Layer& layer) const;
-  // A write of `path` is queued or under way (and no earlier write failed: else that throws).
-  bool queued(const std::string& path) const;
   // The manifest in `dir` against `want` (`prefix`/`exts`: the frame files it covers).
   static Manifested manifested(const std::string& dir, Manifest want, const std::string& prefix,
                                std::initializer_list<const char*> exts);
@@ -109,8 +102,6 @@ class FileStore : public pipeline::Store {
   std::map<std::string, Manifested> layers_;
   Manifested frames_;
   Manifested passes_;
-  // Last: destroyed first, so that queued writes finish while the folder is still locked.
-  std::unique_ptr<BackgroundWriter> writer_;
 };
 
 // `frames` with the shot's pass cache in front of it, when the cache holds passes made under the

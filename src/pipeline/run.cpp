@@ -203,7 +203,6 @@ class ShotRun {
       if (passes_) prev_passes_ = {f, std::move(*passes_)};
       passes_.reset();
     }
-    store_.flush();
     return report_;
   }
 
@@ -360,7 +359,6 @@ int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInpu
     store.write_frame(f, comp.cview(), views, passes.cview());
     ++written;
   }
-  store.flush();
   return written;
 }
 

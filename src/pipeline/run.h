@@ -38,9 +38,6 @@ class Store {
   virtual void write_frame(int frame, ImageView<const float> composite,
                            const std::vector<ImageView<const float>>& layers,
                            ImageView<const float> passes) = 0;
-  // Waits for writes still under way (a store may write in the background) and reports their
-  // errors; run_shot and recomposite call it before they return.
-  virtual void flush() {}
 };
 
 struct Progress {
