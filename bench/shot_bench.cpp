@@ -4,11 +4,15 @@
 //
 //   shot_bench [WIDTHxHEIGHT=1920x1080] [FRAMES=3] [THREADS=0]
 //
-// Frame 0 has no temporal guide; the figure that matters is the mean of the later frames.
+// Frame 0 has no temporal guide; the figure that matters is the mean of the later frames. The
+// split of those frames by layer follows (a layer's time includes its advection, and the first
+// layer's the frame's rendering; "compositing" runs from the composite's start to the next frame).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "core/parallel.h"
 #include "memory_store.h"
@@ -40,15 +44,33 @@ int main(int argc, char** argv) {
     auto t = std::chrono::steady_clock::now();
     int last = -1;
     pipeline::RunOptions o;
+    // Steps (a layer, or compositing) of the temporal frames: each runs from its progress tick
+    // to the next one.
+    std::vector<std::string> order;
+    std::map<std::string, double> step_seconds;
+    std::string step;
+    int step_frame = -1;
+    auto step_t = std::chrono::steady_clock::now();
+    auto end_step = [&](std::chrono::steady_clock::time_point now) {
+      if (step_frame > shot.source.first_frame) {
+        if (!step_seconds.count(step)) order.push_back(step);
+        step_seconds[step] += std::chrono::duration<double>(now - step_t).count();
+      }
+    };
     // Frame boundaries from the progress callback: a frame ends when its compositing starts.
     o.progress = [&](const pipeline::Progress& p) {
+      const auto now = std::chrono::steady_clock::now();
+      end_step(now);
+      step = p.layer.empty() ? "compositing" : p.layer;
+      step_frame = p.frame;
+      step_t = now;
       if (!p.layer.empty() || p.frame == last) return;
       last = p.frame;
-      const auto now = std::chrono::steady_clock::now();
       seconds.push_back(std::chrono::duration<double>(now - t).count());
       t = now;
     };
     pipeline::run_shot(shot, *source, exemplars, ci, store, o);
+    end_step(std::chrono::steady_clock::now());
     double later = 0;
     for (std::size_t i = 1; i < seconds.size(); ++i) later += seconds[i];
     std::printf(
@@ -56,6 +78,10 @@ int main(int argc, char** argv) {
         "frames 1-%d (temporal) %.2f s per frame\n",
         width, height, shot.layers.size(), thread_count(), seconds[0], frames - 1,
         later / double(seconds.size() - 1));
+    std::printf("shot_bench: per temporal frame:");
+    for (const std::string& name : order)
+      std::printf(" %s %.2f s", name.c_str(), step_seconds[name] / double(frames - 1));
+    std::printf("\n");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shot_bench: %s\n", e.what());
     return 1;

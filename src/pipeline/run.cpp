@@ -51,9 +51,10 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
 }
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
-// temporal chain continues.
+// temporal chain continues. `fields`: the frame's advection fields, shared by its layers.
 Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> passes, int frame,
-                              const Image<float>* previous, const Image<float>* previous_passes) {
+                              const Image<float>* previous, const Image<float>* previous_passes,
+                              AdvectionFields* fields) {
   const Layer& l = *p.layer;
   const Image<float> mask = layer_mask(passes, l.mask);
   const int n = p.value_channels;
@@ -88,7 +89,8 @@ Image<float> synthesize_layer(const PreparedLayer& p, ImageView<const float> pas
   }
   temporal::Advection advected;
   if (previous && previous_passes) {
-    advected = advect_layer(l, passes, mask, previous->cview(), previous_passes->cview(), frame);
+    advected =
+        advect_layer(l, passes, mask, previous->cview(), previous_passes->cview(), frame, fields);
     synth::GuidePair pair{fmt::format("layers.{}.temporal", l.name), p.style.cview(),
                           advected.value.cview(), l.temporal.weight};
     if (!advected.confidence.empty()) pair.weight_map = synth::Plane(advected.confidence.cview());
@@ -243,6 +245,7 @@ class ShotRun {
   // are read lazily, only if the chain or the composite needs them. True if any was.
   bool synthesize_frame(int f, std::vector<Held>& now) {
     bool changed = false;
+    AdvectionFields fields;
     for (std::size_t i = 0; i < prepared_.size(); ++i) {
       const Layer& l = *prepared_[i].layer;
       now[i].frame = f;
@@ -263,7 +266,7 @@ class ShotRun {
       }
       tick(f, l.name);
       now[i].value =
-          synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes);
+          synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes, &fields);
       store_.write_layer(l, f, now[i].value.cview());
       ++report_.synthesized;
       changed = true;
@@ -324,7 +327,8 @@ RunReport run_shot(const Shot& shot, const FrameSource& frames,
 Image<float> synthesize_alone(const Layer& layer, const ExemplarImages& exemplar,
                               ImageView<const float> passes, int frame,
                               const WeightMapImages& weight_maps) {
-  return synthesize_layer(prepare(layer, exemplar, weight_maps), passes, frame, nullptr, nullptr);
+  return synthesize_layer(prepare(layer, exemplar, weight_maps), passes, frame, nullptr, nullptr,
+                          nullptr);
 }
 
 int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInputs& ci,

@@ -21,9 +21,21 @@ uint64_t frame_seed(const Layer& l, int frame, int transfer) {
   return hash_key(l.synth.seed, uint64_t(frame), uint64_t(transfer));
 }
 
+const temporal::AdvectionField& AdvectionFields::get(
+    const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
+  const uint64_t seed = frame_seed(l, frame, 1);
+  for (const auto& e : entries_)
+    if (e->guide == l.temporal.guide && e->patch_size == l.synth.patch_size && e->seed == seed)
+      return e->field;
+  entries_.push_back(
+      std::make_unique<Entry>(Entry{l.temporal.guide, l.synth.patch_size, seed, compute()}));
+  return entries_.back()->field;
+}
+
 temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
-                                 ImageView<const float> previous_passes, int frame) {
+                                 ImageView<const float> previous_passes, int frame,
+                                 AdvectionFields* fields) {
   const Image<float> guide_prev = advection_guide(previous_passes, l.temporal.guide);
   const Image<float> guide_cur = advection_guide(passes, l.temporal.guide);
   temporal::AdvectionInputs a;
@@ -46,7 +58,11 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                     rest ? guide_cur.cview() : surf_cur.cview(), motion.cview()};
     a.confidence = l.temporal.confidence_params;
   }
-  return temporal::advect(a, synth_params(l.synth, frame_seed(l, frame, 1)));
+  const synth::Params params = synth_params(l.synth, frame_seed(l, frame, 1));
+  if (!fields) return temporal::advect(a, params);
+  const temporal::AdvectionField& field =
+      fields->get(l, frame, [&] { return temporal::advection_field(a, params); });
+  return temporal::advect(a, params, &field);
 }
 
 }  // namespace emaki::pipeline

@@ -5,6 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
 
 #include "core/image.h"
 #include "pipeline/shot.h"
@@ -20,11 +23,32 @@ synth::Params synth_params(const SynthSpec& s, uint64_t seed);
 // run draws exactly the numbers an uninterrupted one would.
 uint64_t frame_seed(const Layer& l, int frame, int transfer);
 
+// One frame's advection fields, shared by the layers that advect with the same guide, patch size
+// and seed: a field depends on neither a layer's value nor its mask (temporal::advection_field),
+// so the layers of a shot, which differ in those, match once per frame instead of once each.
+class AdvectionFields {
+ public:
+  const temporal::AdvectionField& get(const Layer& layer, int frame,
+                                      const std::function<temporal::AdvectionField()>& compute);
+
+ private:
+  struct Entry {
+    AdvectionGuide guide;
+    int patch_size;
+    uint64_t seed;
+    temporal::AdvectionField field;
+  };
+  std::vector<std::unique_ptr<Entry>> entries_;  // stable addresses
+};
+
 // B'adv of `layer` at `frame`, from its value at frame - 1 (`previous`: value channels, then
 // the mask coverage when it has a mask) and the passes of both frames. `mask`: the layer's mask
 // at `frame` (empty: none). With layer.temporal.confidence the result carries the confidence.
+// `fields`: the frame's fields so far (the field is taken from there, or computed and added);
+// null: computed for this call alone — the same field either way.
 temporal::Advection advect_layer(const Layer& layer, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
-                                 ImageView<const float> previous_passes, int frame);
+                                 ImageView<const float> previous_passes, int frame,
+                                 AdvectionFields* fields = nullptr);
 
 }  // namespace emaki::pipeline

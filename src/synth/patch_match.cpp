@@ -181,12 +181,14 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
       prefetch_candidate(S, band, out[k][0], out[k][1]);
     }
   };
+  // Outside a target mask nothing is drawn: the draws are keyed by pixel, so skipping them changes
+  // no other pixel's, and a masked layer (a shadow, an outline) no longer pays for the whole frame.
   for (int y = ys; y != ye; y += q) {
     int cur = 0;
-    draw(xs, y, cand[cur]);
+    if (is_active(L, xs, y)) draw(xs, y, cand[cur]);
     for (int x = xs; x != xe; x += q) {
       const int next_x = x + q;
-      if (next_x != xe) draw(next_x, y, cand[cur ^ 1]);
+      if (next_x != xe && is_active(L, next_x, y)) draw(next_x, y, cand[cur ^ 1]);
       if (is_active(L, x, y)) {
         int32_t* n = L.nnf->at(x, y);
         float cur_occ = occupancy(S, band, n[0], n[1]);

@@ -4,30 +4,15 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "core/parallel.h"
+#include "synth/voting.h"
 
 namespace emaki::temporal {
 
-Advection advect(const AdvectionInputs& in, const synth::Params& params) {
-  const ImageView<const float> prev = in.previous_stylized;
-  CHECK(!prev.empty());
-  const int n = in.value_channels;
-  CHECK(n == 1 || n == 3);
-  CHECK_GE(prev.channels, n);
-  const bool masked = prev.channels > n;
-  // The style is B'(t-1)'s value, with the empty value where it had no content, so that the
-  // advection never copies the transparent area's zeros into the current frame.
-  Image<float> style(prev.width, prev.height, n);
-  for (int y = 0; y < prev.height; ++y)
-    for (int x = 0; x < prev.width; ++x) {
-      const float* p = prev.at(x, y);
-      const float a = masked ? p[n] : 1.0f;
-      for (int c = 0; c < n; ++c) style(x, y, c) = a * p[c] + (1.0f - a) * in.empty_value;
-    }
-  synth::Inputs inputs;
-  inputs.style = style.cview();
-  inputs.style_name = "previous frame";
-  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, 1.0f});
-  if (in.current_mask) inputs.target_mask = *in.current_mask;
+namespace {
+
+// The advection's own schedule on top of the layer's settings (see advect()).
+synth::Params field_params(const synth::Params& params, int search_radius, int width, int height) {
   synth::Params p = params;
   p.uniformity = 0.0f;
   // Consecutive frames are nearly aligned: the field starts at the identity and is refined at
@@ -40,29 +25,112 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params) {
   // compare it with the current estimate of B'adv, which starts as the unmoved B'(t-1), and
   // hold patches back where the frame moved (measured: more flicker, docs/temporal.md).
   p.style_weight = 0.0f;
-  p.search_radius = in.search_radius > 0
-                        ? in.search_radius
-                        : std::max(8, int(std::lround(std::max(prev.width, prev.height) / 60.0)));
+  p.search_radius = search_radius > 0
+                        ? search_radius
+                        : std::max(8, int(std::lround(std::max(width, height) / 60.0)));
+  return p;
+}
+
+// Where a masked synthesis works: the mask (> 0) dilated by the patch radius, so that pixels at
+// its edge get whole patches — the synthesizer's own rule (synth::Inputs::target_mask).
+Image<uint8_t> active_region(ImageView<const float> mask, int r) {
+  const int w = mask.width, h = mask.height;
+  Image<uint8_t> across(w, h, 1), out(w, h, 1);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 0;
+        for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r) && !v; ++xx)
+          v = mask.at(xx, y)[0] > 0.0f ? 1 : 0;
+        across(x, y) = v;
+      }
+  });
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 0;
+        for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r) && !v; ++yy)
+          v = across(x, yy);
+        out(x, y) = v;
+      }
+  });
+  return out;
+}
+
+}  // namespace
+
+AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& params) {
+  const int w = in.previous_guide.width, h = in.previous_guide.height;
+  // The style takes no part in the match (weight 0): a blank one stands for B'(t-1).
+  Image<float> blank(w, h, 1);
+  synth::Inputs inputs;
+  inputs.style = blank.cview();
+  inputs.style_name = "previous frame";
+  inputs.guides.push_back({in.guide_name, in.previous_guide, in.current_guide, 1.0f});
+  const synth::Params p = field_params(params, in.search_radius, w, h);
   synth::OutputRequest request;
-  request.nnf = request.error = in.surfaces.has_value();
+  request.nnf = request.error = true;
   synth::Result r = synth::synthesize(inputs, p, request);
+  AdvectionField f;
+  f.nnf = std::move(r.nnf);
+  f.error = std::move(r.error);
+  f.patch_size = p.patch_size;
+  if (in.surfaces) f.visible = visible_before(*in.surfaces);
+  return f;
+}
+
+Advection advect(const AdvectionInputs& in, const synth::Params& params,
+                 const AdvectionField* field) {
+  const ImageView<const float> prev = in.previous_stylized;
+  CHECK(!prev.empty());
+  const int n = in.value_channels;
+  CHECK(n == 1 || n == 3);
+  CHECK_GE(prev.channels, n);
+  AdvectionField own;
+  if (field == nullptr) {
+    own = advection_field(in, params);
+    field = &own;
+  }
+  const int w = field->nnf.width(), h = field->nnf.height(), patch = field->patch_size;
+  const bool masked = prev.channels > n;
+  // The style is B'(t-1)'s value, with the empty value where it had no content, so that the
+  // advection never copies the transparent area's zeros into the current frame.
+  Image<float> style(prev.width, prev.height, n);
+  for (int y = 0; y < prev.height; ++y)
+    for (int x = 0; x < prev.width; ++x) {
+      const float* p = prev.at(x, y);
+      const float a = masked ? p[n] : 1.0f;
+      for (int c = 0; c < n; ++c) style(x, y, c) = a * p[c] + (1.0f - a) * in.empty_value;
+    }
+  Image<uint8_t> active;
+  if (in.current_mask) active = active_region(*in.current_mask, patch / 2);
+  Image<float> voted;
+  synth::vote(synth::Plane(style.cview()), field->nnf, field->error, active, patch,
+              params.vote_mode, voted);
   Advection out;
   if (in.surfaces) {
-    out.visible = visible_before(*in.surfaces);
-    out.foreign = foreign_share(r.nnf, *in.surfaces, p.patch_size, p.patch_size / 2);
-    out.confidence = confidence(out.visible, out.foreign, r.error, p.patch_size, in.confidence);
+    // The evidence of this layer's B'adv: the patches that vote it (those centred inside its
+    // active region) and their errors.
+    Image<int32_t> nnf = field->nnf.clone();
+    Image<float> error = field->error.clone();
+    for (int y = 0; y < h && !active.empty(); ++y)
+      for (int x = 0; x < w; ++x)
+        if (!active(x, y)) nnf(x, y, 0) = nnf(x, y, 1) = -1, error(x, y) = 0.0f;
+    out.visible = field->visible.empty() ? visible_before(*in.surfaces) : field->visible.clone();
+    out.foreign = foreign_share(nnf, *in.surfaces, patch, patch / 2);
+    out.confidence = confidence(out.visible, out.foreign, error, patch, in.confidence);
   }
-  if (r.image.channels() == n) {
-    out.value = std::move(r.image);
+  if (!in.current_mask) {
+    out.value = std::move(voted);
     return out;
   }
-  // Drop the alpha the mask added; outside the mask the value is the empty value.
-  out.value.reset(r.image.width(), r.image.height(), n);
-  for (int y = 0; y < out.value.height(); ++y)
-    for (int x = 0; x < out.value.width(); ++x) {
-      const float a = r.image(x, y, n);
+  // Outside the mask the value is the empty value.
+  out.value.reset(w, h, n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float a = std::clamp(in.current_mask->at(x, y)[0], 0.0f, 1.0f);
       for (int c = 0; c < n; ++c)
-        out.value(x, y, c) = a * r.image(x, y, c) + (1.0f - a) * in.empty_value;
+        out.value(x, y, c) = a * (a <= 0.0f ? 0.0f : voted(x, y, c)) + (1.0f - a) * in.empty_value;
     }
   return out;
 }

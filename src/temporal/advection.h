@@ -42,7 +42,22 @@ struct Advection {
   Image<float> foreign;    // foreign_share() of the advection's field
 };
 
-// B'adv (and, with surfaces, its confidence). `params` are the layer's
+// The advection's field of one frame: for each pixel of frame t, the centre of the patch of
+// t-1 it matches on the position guide alone (style weight 0), over the whole frame, with its
+// patch error; with surfaces, visible_before() too. It does not depend on B'(t-1) or on a
+// layer's mask, so one field serves every layer of a frame that advects with the same guide,
+// patch size and seed (pipeline/temporal_guide.h). Reads `in`'s guides, search radius and
+// surfaces only.
+struct AdvectionField {
+  Image<int32_t> nnf;      // the current frame's size, 2 channels
+  Image<float> error;      // EbSynth units
+  Image<uint8_t> visible;  // with surfaces (else empty)
+  int patch_size = 0;
+};
+AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& params);
+
+// B'adv (and, with surfaces, its confidence): B'(t-1) carried along `field` (computed here when
+// null). `params` are the layer's
 // synthesis settings (patch size, seed — which should differ from the main transfer's); the
 // uniformity term is turned off, because an advection is a warp: spreading the use of
 // B'(t-1)'s patches evenly would pull them off the motion; for the same reason patches are
@@ -51,7 +66,10 @@ struct Advection {
 // iteration of two PatchMatch sweeps at full resolution, random search within
 // `search_radius`, refines it. Measured on the example against the main transfer's multiscale
 // schedule with a style weight of 1 against the guide's 1000: less flicker and a third of the
-// advection's time (docs/temporal.md).
-Advection advect(const AdvectionInputs& in, const synth::Params& params);
+// advection's time (docs/temporal.md). The field covers the whole frame; with a mask, B'adv is
+// voted inside it (dilated by the patch radius, as the synthesizer does) from the patches
+// centred there.
+Advection advect(const AdvectionInputs& in, const synth::Params& params,
+                 const AdvectionField* field = nullptr);
 
 }  // namespace emaki::temporal

@@ -91,5 +91,34 @@ TEST(Advection, MaskedPreviousFrameUsesTheEmptyValue) {
   EXPECT_NEAR(adv(w / 2, h / 2), 0.9f, 1e-4f);
 }
 
+// One field serves every layer of a frame: it depends on neither the layer's value nor its mask,
+// so a masked layer carried along a shared field gets exactly what advecting it alone gives, and
+// the same field carries another layer's value too.
+TEST(Advection, OneFieldServesLayersWithOtherValuesAndMasks) {
+  const int w = 64, h = 48;
+  const Image<float> a = stripes(w, h, 0.0f), b = stripes(w, h, 2.5f);
+  const Image<float> g_prev = position_guide(w, h, 0.0f), g_cur = position_guide(w, h, 3.0f);
+  Image<float> mask(w, h, 1);
+  for (int y = 10; y < 30; ++y)
+    for (int x = 20; x < 50; ++x) mask(x, y) = 1.0f;
+  AdvectionInputs in;
+  in.previous_guide = g_prev.cview();
+  in.current_guide = g_cur.cview();
+  synth::Params p;
+  p.patch_size = 5;
+  in.previous_stylized = a.cview();
+  const AdvectionField field = advection_field(in, p);
+  for (const Image<float>* value : {&a, &b})
+    for (const bool masked : {false, true}) {
+      in.previous_stylized = value->cview();
+      in.current_mask.reset();
+      if (masked) in.current_mask = mask.cview();
+      const Image<float> alone = advect(in, p).value, shared = advect(in, p, &field).value;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) ASSERT_EQ(alone(x, y), shared(x, y)) << x << "," << y;
+      if (masked) EXPECT_EQ(shared(0, 0), in.empty_value);  // outside the mask
+    }
+}
+
 }  // namespace
 }  // namespace emaki::temporal
