@@ -106,14 +106,15 @@ def render(emaki, scene, out_dir, w, h, frame=0, clip=None):
 
 def sphere_normal(path, size):
     """A MatCap's guide: the camera-space normal of a sphere filling the square image, in the
-    previews' encoding (n * 0.5 + 0.5; 0 outside the sphere, as emaki's background)."""
+    previews' encoding (n * 0.5 + 0.5 on surfaces, black where there is none, as emaki's
+    background)."""
     c = (np.arange(size) + 0.5) / size * 2.0 - 1.0
     x, y = np.meshgrid(c, -c)
     r2 = x * x + y * y
     inside = r2 < 1.0
     z = np.sqrt(np.clip(1.0 - r2, 0, 1))
     n = np.stack([x, y, z], axis=2) * inside[..., None]
-    write_png(path, n * 0.5 + 0.5)
+    write_png(path, (n * 0.5 + 0.5) * inside[..., None])
 
 
 def matcap(name, size, path, shared, tmp_dir):
