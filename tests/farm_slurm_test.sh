@@ -123,9 +123,18 @@ status=$("$emaki" farm status "$work/c.toml" --chunk 4)
 echo "$status" | grep -qE "^c.layer.base.0-11 +failed +.*stopped while running" || fail "the cancelled task is not reported stopped while running"
 echo "$status" | grep '^c.composite' | grep -q 'done' && fail "compositing ran after a cancelled layer"
 echo "$status" | tail -n 1
+leftovers=$(find "$work/c" -name '.*.emaki-tmp-*' | wc -l)
+echo "temporaries the cancelled task left: $leftovers"
+# One for certain, as a task killed while writing frame 5 leaves it.
+echo partial >"$work/c/layers/base/.base_0005.emaki-tmp-0123456789abcdef.exr"
 "$emaki" farm submit "$work/c.toml" --chunk 4 || fail "submit c again"
+left=$(find "$work/c" -name '.*.emaki-tmp-*')
+[ -z "$left" ] || fail "resubmitting left the cancelled task's temporaries: $left"
 wait_queue 300
-"$emaki" farm status "$work/c.toml" --chunk 4 | grep -vE ' done |^[0-9]+ done$' && fail "c not done after resubmitting"
+# status plans with the chunk the shot was submitted with (farm/chunk), or refuses another one.
+"$emaki" farm status "$work/c.toml" | grep -vE ' done |^[0-9]+ done$' && fail "c not done after resubmitting"
+other=$("$emaki" farm status "$work/c.toml" --chunk 3 2>&1) && fail "status with another chunk: $other"
+echo "$other" | grep -q -- "--chunk.*submitted with chunk 4, not 3" || fail "status with another chunk: $other"
 same_outputs "$work/ref_c" "$work/c"
 
 # --- 3. a shot with a bad input beside a good one

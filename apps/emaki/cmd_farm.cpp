@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,7 +42,9 @@ struct PlanArgs {
 
   void bind(CLI::App& app) {
     app.add_option("shots", shots, "shot files (TOML)")->required();
-    app.add_option("--chunk", chunk, "frames per passes / layer / composite task (default 8)");
+    app.add_option("--chunk", chunk,
+                   "frames per passes / layer / composite task (default 8; status: the "
+                   "submission's)");
     app.add_option("--threads", threads, "threads (CPUs) per task (default 1)");
   }
   shot::Plan make() const {
@@ -97,7 +100,15 @@ int farm_status(const Args& args) {
   PlanArgs p;
   p.bind(app);
   if (parse_cli(app, args)) return 0;
-  const shot::Plan plan = p.make();
+  shot::Plan plan = p.make();
+  // Task ids name their frames: plan as the shots were submitted.
+  if (const std::optional<int> chunk = farm::submitted_chunk(plan); chunk && *chunk != p.chunk) {
+    if (app.count("--chunk") > 0)
+      throw Error(Error::Field{"chunk"},
+                  fmt::format("the shots were submitted with chunk {}, not {}", *chunk, p.chunk));
+    p.chunk = *chunk;
+    plan = p.make();
+  }
   std::map<std::string, int> count;
   for (const farm::TaskStatus& st : farm::status(plan)) {
     const char* state = farm::task_state_name(st.state);

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -13,6 +14,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "farm/process.h"
+#include "io/file_store.h"
 #include "io/output_store.h"
 
 namespace emaki::farm {
@@ -76,6 +78,35 @@ void append_jobs(const std::string& folder, const std::vector<const Task*>& task
   for (std::size_t i = 0; i < tasks.size(); ++i)
     out << tasks[i]->id << '\t' << job << '\t' << i << '\n';
   if (!out) throw Error(folder + "/jobs.tsv", "cannot record the submitted jobs");
+}
+
+// farm/chunk: the chunk of the last submission, one decimal number.
+void record_chunk(const std::string& folder, int chunk) {
+  fs::create_directories(folder);
+  const std::string path = folder + "/chunk";
+  io::TempFile tmp(path, "farm record");
+  const std::string text = fmt::format("{}\n", chunk);
+  if (::write(tmp.fd(), text.data(), text.size()) != ssize_t(text.size()))
+    throw Error(path, "cannot record the submission's chunk");
+  tmp.commit();
+}
+
+std::optional<int> read_chunk(const std::string& folder) {
+  const std::string path = folder + "/chunk";
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  char buf[32] = {};
+  in.read(buf, sizeof buf - 1);
+  std::string text(buf, std::size_t(in.gcount()));
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+  int chunk = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), chunk);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || chunk < 1 ||
+      chunk > kMaxFrameCount)
+    throw Error(path, fmt::format("is not a chunk of frames in [1, {}]: '{}'; submit the shot "
+                                  "again or pass --chunk",
+                                  kMaxFrameCount, echo(text, 40)));
+  return chunk;
 }
 
 // The queue: "JOBID_INDEX" -> (state, reason), every array element on its own line.
@@ -178,8 +209,14 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
   Submitted out;
   const auto q = o.dry_run ? decltype(queue())() : queue();
   for (int s = 0; s < int(plan.shots.size()); ++s) {
-    if (!o.dry_run) check_nothing_queued(plan, s, q);
     const std::string farm = farm_folder(plan, s);
+    if (!o.dry_run) {
+      check_nothing_queued(plan, s, q);
+      // No task of the shot runs now: what a cancelled or killed task left half-written goes
+      // (farm tasks leave clean-up to each other), as `emaki run` does when it starts.
+      io::FileStore(plan.shots[std::size_t(s)].shot, io::StoreMode::kRun, io::StoreAccess::kAlone);
+      record_chunk(farm, plan.chunk);
+    }
     std::map<std::string, std::string> job_of_task;  // this submission's
     for (shot::TaskKind kind :
          {shot::TaskKind::kPrepare, shot::TaskKind::kPasses, shot::TaskKind::kLayer,
@@ -212,10 +249,9 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
         throw Error(path, "cannot write the batch script");
       tmp.commit();
       // A task's record starts afresh: no exit code or log of an earlier submission.
-      for (const Task* t : tasks) {
-        fs::remove(farm + "/status/" + t->id + ".exit");
-        fs::remove(farm + "/logs/" + t->id + ".log");
-      }
+      for (const Task* t : tasks)
+        for (const char* f : {"/status/{}.exit", "/status/{}.exit.tmp", "/logs/{}.log"})
+          fs::remove(farm + fmt::format(fmt::runtime(f), t->id));
       const std::string job = sbatch(path);
       append_jobs(farm, tasks, job);
       for (const Task* t : tasks) job_of_task[t->id] = job;
@@ -288,6 +324,24 @@ std::vector<TaskStatus> status(const Plan& plan) {
   std::vector<TaskStatus> out;
   for (const Task& t : plan.tasks) out.push_back(status_of(plan, t, jobs[std::size_t(t.shot)], q));
   return out;
+}
+
+std::optional<int> submitted_chunk(const Plan& plan) {
+  std::optional<int> chunk;
+  std::string first;
+  for (int s = 0; s < int(plan.shots.size()); ++s) {
+    const std::optional<int> c = read_chunk(farm_folder(plan, s));
+    if (!c) continue;
+    const std::string& path = plan.shots[std::size_t(s)].path;
+    if (chunk && *c != *chunk)
+      throw Error(Error::Field{"chunk"},
+                  fmt::format("'{}' was submitted with chunk {} and '{}' with {}: ask for them "
+                              "one at a time",
+                              echo_path(first), *chunk, echo_path(path), *c));
+    chunk = c;
+    first = path;
+  }
+  return chunk;
 }
 
 int cancel(const Plan& plan) {

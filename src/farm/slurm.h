@@ -5,6 +5,7 @@
 // shot files, their inputs and the output folders under the same paths.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,12 @@ struct TaskStatus {
 
 // Every task's state, from the queue (squeue), the exit codes and the outputs on disk.
 std::vector<TaskStatus> status(const shot::Plan& plan);
+
+// The chunk (`--chunk`) the plan's shots were last submitted with, recorded by submit in
+// farm/chunk: status must plan with it, for task ids name their frames. Empty when no shot was
+// submitted. Throws emaki::Error naming a shot's record when it is not a chunk, or the field
+// "chunk" when the shots were submitted with different chunks.
+std::optional<int> submitted_chunk(const shot::Plan& plan);
 
 // Cancels every queued job of the plan's shots (scancel). Returns the job arrays cancelled.
 int cancel(const shot::Plan& plan);

@@ -199,6 +199,7 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
     throw Error(Error::Field{"threads"},
                 fmt::format("must be in [1, 1024], got {}", options.threads));
   Plan p;
+  p.chunk = options.chunk;
   std::map<std::string, int> names;
   std::map<std::string, std::string> folders;
   for (PlannedShot& s : shots) {

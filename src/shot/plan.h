@@ -45,6 +45,7 @@ struct PlannedShot {
 struct Plan {
   std::vector<PlannedShot> shots;
   std::vector<Task> tasks;  // in an order that respects `after`
+  int chunk = 8;            // the options' chunk: task ids depend on it
 };
 
 struct PlanOptions {
