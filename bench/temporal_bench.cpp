@@ -5,7 +5,9 @@
 // object id), on ghosts
 // (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with --judge, on the
 // independent judge's `style` energy of sampled frames (is the output still made of exemplar
-// texture?). Frames stay in memory; nothing is written except the judge's inputs and, with
+// texture?) and coverage, and on drift (the mean value of the layer, white outside its mask, 0-255,
+// against frame by frame over the last quarter of the frames: a chain that darkens or fades).
+// Frames stay in memory; nothing is written except the judge's inputs and, with
 // --save, the variants' layer frames as PNGs.
 //
 //   temporal_bench [--shot SHOT.toml] [--size WxH (the shot's)] [--frames 48] [--layer base]
@@ -209,7 +211,17 @@ struct Variant {
   pipeline::SequenceFlicker flicker;
   pipeline::GhostStats ghost;
   double style_sum = 0.0, coverage_sum = 0.0;
+  double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
+  int drift_frames = 0;
 };
+
+double mean_value(const Image<float>& v) {
+  double sum = 0.0;
+  for (int y = 0; y < v.height(); ++y)
+    for (int x = 0; x < v.width(); ++x)
+      for (int c = 0; c < v.channels(); ++c) sum += v(x, y, c);
+  return sum / (double(v.width()) * v.height() * v.channels());
+}
 
 // Flicker per object id (rows) and variant (columns), and each variant against the first.
 void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& variants) {
@@ -323,7 +335,7 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
 // when it is the first one) and, with --save, the frame as a PNG.
 void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& layer,
                    const Image<float>& passes, const Image<float>& prev_passes, int f,
-                   const Options& opt) {
+                   bool drift_frame, const Options& opt) {
   const int n = layer.single_colour ? 1 : 3;
   const Image<float> cur = v.store.read_layer(layer, f), prev = v.store.read_layer(layer, f - 1);
   const int mask_channel = cur.channels() > n ? n : -1;
@@ -334,6 +346,10 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
     v.ghost.add(pipeline::frame_ghost(v.layer, cur.cview(), prev.cview(), ref.cview(),
                                       passes.cview(), prev_passes.cview(), f)
                     .stats);
+    if (drift_frame) {
+      v.drift_sum += mean_value(on_white(cur, n)) - mean_value(on_white(ref, n));
+      ++v.drift_frames;
+    }
   }
   if (!opt.save.empty())
     write_png(fmt::format("{}/{}_{:04d}.png", opt.save, v.name, f), on_white(cur, n));
@@ -344,9 +360,9 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
   std::printf("temporal_bench: layer '%s', %dx%d, frames %d-%d, %d threads%s\n", opt.layer.c_str(),
               opt.width, opt.height, first, last, thread_count(),
               judged ? fmt::format(", judge on {} frames", judged).c_str() : "");
-  std::printf("%-24s %8s %9s %9s %9s %9s %12s %9s %9s %9s %9s\n", "variant", "s/frame", "flicker",
-              "fox", "ground", "vs frame", "judge style", "coverage", "ghost", "diff hid",
-              "diff vis");
+  std::printf("%-24s %8s %9s %9s %9s %9s %12s %9s %9s %9s %9s %7s\n", "variant", "s/frame",
+              "flicker", "fox", "ground", "vs frame", "judge style", "coverage", "ghost",
+              "diff hid", "diff vis", "drift");
   const Variant& base = variants[0];
   const bool ref = base.name == "frame";
   const double base_style = ref && judged ? base.style_sum / judged : 0.0;
@@ -361,13 +377,16 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
     const bool ghosted = ref && v.layer.temporal.enabled;
     const std::string coverage_text =
         judged ? fmt::format("{:.4f}", v.coverage_sum / judged) : std::string("-");
-    std::printf("%-24s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s %9s\n", v.name.c_str(),
+    const std::string drift_text =
+        v.drift_frames ? fmt::format("{:+.2f}", 255.0 * v.drift_sum / v.drift_frames) : "-";
+    std::printf("%-24s %8.2f %9.5f %9.5f %9.5f %8.2fx %12s %9s %9s %9s %9s %7s\n", v.name.c_str(),
                 v.seconds / opt.frames, v.flicker.all.mean(), v.flicker.objects.mean(),
                 v.flicker.ground.mean(), ref ? v.flicker.all.mean() / base.flicker.all.mean() : 0.0,
                 style_text.c_str(), coverage_text.c_str(),
                 ghosted ? fmt::format("{:.4f}", v.ghost.ghost_share()).c_str() : "-",
                 ghosted ? fmt::format("{:.5f}", v.ghost.diff()).c_str() : "-",
-                ghosted ? fmt::format("{:.5f}", v.ghost.visible_diff()).c_str() : "-");
+                ghosted ? fmt::format("{:.5f}", v.ghost.visible_diff()).c_str() : "-",
+                drift_text.c_str());
   }
 }
 
@@ -393,8 +412,10 @@ int main(int argc, char** argv) {
     Image<float> prev_passes = source->passes(first);
     for (int f = first + 1; f <= last; ++f) {
       Image<float> passes = source->passes(f);
+      // Drift: the last quarter of the frames (at least one), where a chain has had time to.
+      const bool drift_frame = 4 * (last - f) < last - first + 1;
       for (Variant& v : variants)
-        measure_frame(v, variants[0], *layer, passes, prev_passes, f, opt);
+        measure_frame(v, variants[0], *layer, passes, prev_passes, f, drift_frame, opt);
       if (judging && (f - first) % opt.judge_every == opt.judge_every / 2) {
         judge_frame(judge_fixed, *layer, passes, f, variants, opt);
         ++judged;
