@@ -90,8 +90,17 @@ struct Params {
   // whole exemplar). With emaki's schedule it is chosen per level.
   int search_radius = 0;
   FieldInit init = FieldInit::kRandom;
-  // emaki's schedule only: search-vote iterations at the finest level (-1: the schedule's 2).
+  // emaki's schedule only: search-vote iterations at the finest level (-1: the schedule's 2)
+  // and PatchMatch sweeps in each of them (-1: the schedule's 2).
   int finest_search_vote_iters = -1;
+  int finest_patch_match_iters = -1;
+  // Optional warm start: the finest level's starting field, the target's size, 2 channels (the
+  // source patch centre x, y, as Result::nnf gives it; the caller's, read only by the
+  // constructor). With it the run is the finest level alone (pyramid_levels is taken as 1, so
+  // the schedule is that of the finest level) and `init` does not count. An entry whose patch
+  // leaves the source (such as Result::nnf's (-1, -1) outside a mask) starts at a random draw
+  // keyed by `seed` and the pixel, as FieldInit::kRandom would.
+  ImageView<const int32_t> initial_nnf = {};
   bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
   VoteMode vote_mode = VoteMode::kWeighted;
   uint64_t seed = 1;
