@@ -174,12 +174,10 @@ void validate(const Inputs& in, const Params& p) {
     throw Error(first_target, fmt::format("target {}x{} is smaller than the {}x{} patch", tw, th,
                                           p.patch_size, p.patch_size));
   check_weight_maps(in, p, tw, th);
-  if (!p.initial_nnf.empty() &&
-      (p.initial_nnf.width != tw || p.initial_nnf.height != th || p.initial_nnf.channels != 2))
-    throw Error(
-        F{"initial_nnf"},
-        fmt::format("is {}x{} with {} channels, the target is {}x{} (2 channels needed)",
-                    p.initial_nnf.width, p.initial_nnf.height, p.initial_nnf.channels, tw, th));
+  const ImageView<const int32_t>& init = p.initial_nnf;
+  if (!init.empty() && (init.width != tw || init.height != th || init.channels != 2))
+    throw Error(F{"initial_nnf"}, fmt::format("is {}x{}x{}, the target {}x{}x2", init.width,
+                                              init.height, init.channels, tw, th));
   if (in.target_mask) {
     if (plane_width(*in.target_mask) != tw || plane_height(*in.target_mask) != th)
       throw Error(in.target_mask_name,
@@ -315,15 +313,12 @@ void write_style(const Image<float>& style, const FeatureLayout& L, Image<int16_
 // The warm start's field: `given` where its patch lies inside the source, a random draw
 // elsewhere.
 Image<int32_t> warm_nnf(ImageView<const int32_t> given, int sw, int sh, int r, uint64_t seed) {
-  const int tw = given.width, th = given.height;
-  Image<int32_t> out = random_nnf(tw, th, sw, sh, r, seed);
-  parallel_rows(th, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < tw; ++x) {
-        const int32_t sx = given(x, y, 0), sy = given(x, y, 1);
-        if (sx >= r && sx < sw - r && sy >= r && sy < sh - r) out(x, y, 0) = sx, out(x, y, 1) = sy;
-      }
-  });
+  Image<int32_t> out = random_nnf(given.width, given.height, sw, sh, r, seed);
+  for (int y = 0; y < given.height; ++y)
+    for (int x = 0; x < given.width; ++x) {
+      const int32_t sx = given(x, y, 0), sy = given(x, y, 1);
+      if (sx >= r && sx < sw - r && sy >= r && sy < sh - r) out(x, y, 0) = sx, out(x, y, 1) = sy;
+    }
   return out;
 }
 
