@@ -59,13 +59,17 @@ struct LayerFrame {
   Image<int32_t> nnf;
 };
 
-// The main transfer's schedule with a warm start: the finest level alone, with
-// finest_search_vote_iters search-vote iterations of finest_patch_match_iters sweeps.
-void warm_schedule(synth::Params& p) {
-  p.finest_search_vote_iters = 1;
-  p.finest_patch_match_iters = 2;
-  if (const char* e = std::getenv("EMAKI_WARM_SV")) p.finest_search_vote_iters = std::atoi(e);
-  if (const char* e = std::getenv("EMAKI_WARM_PM")) p.finest_patch_match_iters = std::atoi(e);
+// The main transfer's schedule with a warm start: the finest level alone, `kWarmSearchVote`
+// search-vote iterations of `kWarmPatchMatch` sweeps within `kWarmRadius` pixels, unless the
+// layer sets its own counts (which then hold at that one level as at every other).
+void warm_schedule(const SynthSpec& s, synth::Params& p) {
+  if (s.search_vote_iters >= 0 || s.patch_match_iters >= 0) return;
+  p.search_vote_iters = 1;
+  p.patch_match_iters = 2;
+  p.search_radius = 32;
+  if (const char* e = std::getenv("EMAKI_WARM_SV")) p.search_vote_iters = std::atoi(e);
+  if (const char* e = std::getenv("EMAKI_WARM_PM")) p.patch_match_iters = std::atoi(e);
+  if (const char* e = std::getenv("EMAKI_WARM_R")) p.search_radius = std::atoi(e);
 }
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
@@ -127,7 +131,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
       warm = carry_field(previous_nnf, *field);
       params.initial_nnf = warm.cview();
-      warm_schedule(params);
+      warm_schedule(l.synth, params);
     }
   }
   synth::OutputRequest request;

@@ -23,12 +23,9 @@ uint64_t frame_seed(const Layer& l, int frame, int transfer) {
 
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
-  const uint64_t seed = frame_seed(l, frame, 1);
-  for (const auto& e : entries_)
-    if (e->guide == l.temporal.guide && e->patch_size == l.synth.patch_size && e->seed == seed)
-      return e->field;
-  entries_.push_back(
-      std::make_unique<Entry>(Entry{l.temporal.guide, l.synth.patch_size, seed, compute()}));
+  if (const temporal::AdvectionField* f = find(l, frame)) return *f;
+  entries_.push_back(std::make_unique<Entry>(
+      Entry{l.temporal.guide, l.synth.patch_size, frame_seed(l, frame, 1), compute()}));
   return entries_.back()->field;
 }
 

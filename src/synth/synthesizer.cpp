@@ -132,7 +132,6 @@ void validate(const Inputs& in, const Params& p) {
   if (p.search_radius < 0) throw Error(F{"search_radius"}, "must be >= 0 (0: the whole exemplar)");
   if (!std::isfinite(p.style_weight)) throw Error(F{"style_weight"}, "must be finite");
   if (p.finest_search_vote_iters < -1) throw Error(F{"finest_search_vote_iters"}, "must be >= 0");
-  if (p.finest_patch_match_iters < -1) throw Error(F{"finest_patch_match_iters"}, "must be >= 0");
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
   const int ns = plane_channels(in.style);
@@ -207,8 +206,7 @@ std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
   for (int l = 0; l < levels; ++l) {
     const int from_finest = levels - 1 - l;
     if (from_finest == 0)
-      s[l] = {p.finest_search_vote_iters >= 0 ? p.finest_search_vote_iters : 2,
-              p.finest_patch_match_iters >= 0 ? p.finest_patch_match_iters : 2, 32};
+      s[l] = {p.finest_search_vote_iters >= 0 ? p.finest_search_vote_iters : 2, 2, 32};
     else if (from_finest == 1)
       s[l] = {2, 3, 32};
     else if (from_finest == 2)

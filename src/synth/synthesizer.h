@@ -90,10 +90,8 @@ struct Params {
   // whole exemplar). With emaki's schedule it is chosen per level.
   int search_radius = 0;
   FieldInit init = FieldInit::kRandom;
-  // emaki's schedule only: search-vote iterations at the finest level (-1: the schedule's 2)
-  // and PatchMatch sweeps in each of them (-1: the schedule's 2).
+  // emaki's schedule only: search-vote iterations at the finest level (-1: the schedule's 2).
   int finest_search_vote_iters = -1;
-  int finest_patch_match_iters = -1;
   // Optional warm start: the finest level's starting field, the target's size, 2 channels (the
   // source patch centre x, y, as Result::nnf gives it; the caller's, read only by the
   // constructor). With it the run is the finest level alone (pyramid_levels is taken as 1, so
