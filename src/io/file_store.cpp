@@ -312,6 +312,10 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
   exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
   exr.channel_names = value_names("", value.channels, n);
   write_image(paths_.layer_exr(layer.name, frame), value, exr);
+  // Frame `frame` is finished: the field of the frame before has done its work (a resumed run
+  // continues from this frame's), and at 8 bytes a pixel it is not worth its disk.
+  std::error_code ec;
+  fs::remove(paths_.layer_field(layer.name, frame - 1), ec);
 }
 
 void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
