@@ -360,6 +360,50 @@ TEST_F(ShotCli, CompositeRecoloursWithoutSynthesizing) {
 
 // ---- resume ----
 
+// The field kept beside each temporal layer frame (the next frame's warm start) is read as
+// hostile input: a truncated, resized, garbled or stale one never breaks a resumed run (the
+// frame runs the whole pyramid instead); junk inside a well-formed one is drawn at random where
+// it leaves the exemplar. The intact field gives the frame back bit for bit.
+TEST_F(ShotCli, DamagedWarmStartFieldsNeverBreakAResume) {
+  write_shot(shot_text(2));
+  RunResult r = emaki("run shot.toml --frames 0-1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path field = dir_ / "out/layers/base/.base_0001.nnf";
+  const fs::path frame = dir_ / "out/layers/base/base_0002.exr";
+  ASSERT_TRUE(fs::is_regular_file(field));
+  // Only the last finished frame's field is kept.
+  EXPECT_FALSE(fs::exists(dir_ / "out/layers/base/.base_0000.nnf"));
+  const std::string good = slurp(field);
+  r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(field));
+  ASSERT_TRUE(fs::is_regular_file(dir_ / "out/layers/base/.base_0002.nnf"));
+  fs::copy_file(frame, dir_ / "ref.exr");
+  ASSERT_EQ(good.size(), 32u + 64u * 48u * 8u);
+  std::string junk = good, magic = good, other = good;
+  for (std::size_t i = 32; i < junk.size(); ++i) junk[i] = char(i * 131 + 7);
+  magic[0] = 'X';
+  other[24] ^= 1;  // the digest of another value
+  const std::vector<std::pair<std::string, std::string>> damaged = {
+      {"truncated", good.substr(0, good.size() - 4)},
+      {"header only", good.substr(0, 32)},
+      {"empty", ""},
+      {"longer", good + "xxxxxxxx"},
+      {"bad magic", magic},
+      {"stale", other},
+      {"junk inside", junk},
+      {"intact", good}};
+  for (const auto& [what, bytes] : damaged) {
+    std::ofstream(field, std::ios::binary | std::ios::trunc) << bytes;
+    fs::remove(frame);
+    r = emaki("run shot.toml");
+    ASSERT_EQ(r.exit_code, 0) << what << ": " << r.err;
+    ASSERT_TRUE(fs::is_regular_file(frame)) << what;
+    if (what == "stale") EXPECT_FALSE(same_pixels(frame, dir_ / "ref.exr")) << what;
+    if (what == "intact") EXPECT_TRUE(same_pixels(frame, dir_ / "ref.exr")) << what;
+  }
+}
+
 TEST_F(ShotCli, KilledRunResumesToBitIdenticalFrames) {
   const int last = 7;
   write_shot(shot_text(last));

@@ -1,8 +1,12 @@
 #include "io/file_store.h"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
 
 #include "core/check.h"
@@ -22,6 +26,9 @@ std::string OutputPaths::layer_exr(const std::string& layer, int frame) const {
 }
 std::string OutputPaths::layer_png(const std::string& layer, int frame) const {
   return fmt::format("{}/layers/{}/{}_{:04d}.png", folder, layer, layer, frame);
+}
+std::string OutputPaths::layer_field(const std::string& layer, int frame) const {
+  return fmt::format("{}/layers/{}/.{}_{:04d}.nnf", folder, layer, layer, frame);
 }
 std::string OutputPaths::composite_png(int frame) const {
   return fmt::format("{}/composite/frame_{:04d}.png", folder, frame);
@@ -77,6 +84,37 @@ void remove_frames(const fs::path& dir, const std::string& prefix,
     if (is_frame_name(entry.path().filename().string(), prefix, exts) && !entry.is_directory(ec))
       doomed.push_back(entry.path());
   for (const fs::path& p : doomed) fs::remove(p, ec);
+}
+
+// A layer's frame files: its PNGs and EXRs, and its hidden fields (".base_0007.nnf").
+bool is_layer_file(const std::string& name, const std::string& layer) {
+  return is_frame_name(name, layer + "_", {".png", ".exr"}) ||
+         is_frame_name(name, "." + layer + "_", {".nnf"});
+}
+
+void remove_layer_frames(const fs::path& dir, const std::string& layer) {
+  remove_frames(dir, layer + "_", {".png", ".exr"});
+  remove_frames(dir, "." + layer + "_", {".nnf"});
+}
+
+// The field file: this header, then width x height x 2 int32 in the machine's byte order.
+struct FieldHeader {
+  char magic[8] = {'E', 'M', 'A', 'K', 'I', 'N', 'N', 'F'};
+  uint32_t version = 1;
+  int32_t frame = 0, width = 0, height = 0;
+  uint64_t digest = 0;
+};
+static_assert(sizeof(FieldHeader) == 32);
+
+void write_all(int fd, const void* data, std::size_t size, const std::string& path) {
+  const auto* p = static_cast<const char*>(data);
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, p + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error(path, "write failed (disk full?)");
+    done += std::size_t(n);
+  }
 }
 
 bool any_frame(const fs::path& dir, const std::string& prefix,
@@ -147,9 +185,7 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
   for (const pipeline::Layer& l : shot.layers) {
     const fs::path dir = root / "layers" / l.name;
     make_folder(dir);
-    clean_up(dir, [&](const std::string& t) {
-      return t == kManifest || is_frame_name(t, l.name + "_", {".png", ".exr"});
-    });
+    clean_up(dir, [&](const std::string& t) { return t == kManifest || is_layer_file(t, l.name); });
     layers_[l.name] =
         manifested(dir.string(), layer_manifest(shot, l), l.name + "_", {".png", ".exr"});
   }
@@ -190,9 +226,7 @@ void FileStore::prepare() {
   const fs::path root(paths_.folder);
   for (const pipeline::Layer& l : shot_.layers)
     make_current(layers_.at(l.name), (root / "layers" / l.name).string(),
-                 [&](const std::string& dir) {
-                   remove_frames(dir, l.name + "_", {".png", ".exr"});
-                 });
+                 [&](const std::string& dir) { remove_layer_frames(dir, l.name); });
   make_current(frames_, (root / "composite").string(), [&](const std::string&) {
     remove_frames(root / "composite", "frame_", {".png", ".exr"});
     remove_frames(root / "layered", "frame_", {".exr"});
@@ -266,9 +300,7 @@ Image<float> FileStore::read_layer(const pipeline::Layer& layer, int frame) cons
 void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) {
   CHECK(access_ != StoreAccess::kInspect);
   make_current(layers_.at(layer.name), (fs::path(paths_.folder) / "layers" / layer.name).string(),
-               [&](const std::string& dir) {
-                 remove_frames(dir, layer.name + "_", {".png", ".exr"});
-               });
+               [&](const std::string& dir) { remove_layer_frames(dir, layer.name); });
   const int n = layer.single_colour ? 1 : 3;
   // The PNG first: the EXR is what marks the frame finished, so it is written last.
   if (shot_.outputs.layer_png) {
@@ -280,6 +312,49 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
   exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
   exr.channel_names = value_names("", value.channels, n);
   write_image(paths_.layer_exr(layer.name, frame), value, exr);
+  // Frame `frame` is finished: the field of the frame before has done its work (a resumed run
+  // continues from this frame's), and at 8 bytes a pixel it is not worth its disk.
+  std::error_code ec;
+  fs::remove(paths_.layer_field(layer.name, frame - 1), ec);
+}
+
+void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
+                            uint64_t digest) {
+  CHECK(access_ != StoreAccess::kInspect);
+  CHECK_EQ(nnf.channels, 2);
+  make_current(layers_.at(layer.name), (fs::path(paths_.folder) / "layers" / layer.name).string(),
+               [&](const std::string& dir) { remove_layer_frames(dir, layer.name); });
+  const std::string path = paths_.layer_field(layer.name, frame);
+  FieldHeader h;
+  h.frame = frame, h.width = nnf.width, h.height = nnf.height, h.digest = digest;
+  TempFile tmp(path, path);
+  write_all(tmp.fd(), &h, sizeof h, path);
+  for (int y = 0; y < nnf.height; ++y)
+    write_all(tmp.fd(), nnf.row(y), sizeof(int32_t) * 2 * std::size_t(nnf.width), path);
+  tmp.commit();
+}
+
+Image<int32_t> FileStore::read_field(const pipeline::Layer& layer, int frame,
+                                     uint64_t digest) const {
+  if (!layer_state(layer).current) return {};
+  const std::string path = paths_.layer_field(layer.name, frame);
+  const int w = shot_.source.width, h = shot_.source.height;
+  const std::size_t row_bytes = sizeof(int32_t) * 2 * std::size_t(w);
+  std::error_code ec;
+  // The size first: nothing is allocated for a file that cannot be this frame's field.
+  if (!fs::is_regular_file(path, ec) ||
+      fs::file_size(path, ec) != sizeof(FieldHeader) + row_bytes * std::size_t(h) || ec)
+    return {};
+  std::ifstream in(path, std::ios::binary);
+  FieldHeader want, have;
+  want.frame = frame, want.width = w, want.height = h, want.digest = digest;
+  if (!in.read(reinterpret_cast<char*>(&have), sizeof have) ||
+      std::memcmp(&have, &want, sizeof have) != 0)
+    return {};
+  Image<int32_t> nnf(w, h, 2);
+  for (int y = 0; y < h; ++y)
+    if (!in.read(reinterpret_cast<char*>(nnf.row(y)), std::streamsize(row_bytes))) return {};
+  return nnf;
 }
 
 bool FileStore::has_frame(int frame) const {

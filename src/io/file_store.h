@@ -29,6 +29,8 @@ struct OutputPaths {
   std::string folder;
   std::string layer_exr(const std::string& layer, int frame) const;
   std::string layer_png(const std::string& layer, int frame) const;
+  // A temporal layer's field (the next frame's warm start), hidden beside its frame.
+  std::string layer_field(const std::string& layer, int frame) const;
   std::string composite_png(int frame) const;
   std::string composite_exr(int frame) const;
   std::string layered_exr(int frame) const;
@@ -74,6 +76,15 @@ class FileStore : public pipeline::Store {
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
+  // Only the field of a layer's last finished frame is kept: write_layer(frame) removes that of
+  // frame - 1 (so a run of frames a-b after a finished a - 1 runs frame a from the whole pyramid
+  // unless a - 1 was the last one finished). The field file is read as hostile input: anything but
+  // the exact header (magic, version, frame, the shot's size, the digest) and size gives an empty
+  // field, never a crash; the synthesizer draws any entry outside the exemplar at random.
+  void write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
+                   uint64_t digest) override;
+  Image<int32_t> read_field(const pipeline::Layer& layer, int frame,
+                            uint64_t digest) const override;
   bool has_frame(int frame) const override;
   void write_frame(int frame, ImageView<const float> composite,
                    const std::vector<ImageView<const float>>& layers,

@@ -124,8 +124,9 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
                                  s.patch_match_iters, s.seed));
   l.add(p + "single_colour", layer.single_colour);
   l.add(p + "channel", layer.channel);
-  l.add(p + "temporal", fmt::format("{} weight {} guide {}", layer.temporal.enabled,
-                                    layer.temporal.weight, int(layer.temporal.guide)));
+  l.add(p + "temporal",
+        fmt::format("{} weight {} guide {} warm_start {}", layer.temporal.enabled,
+                    layer.temporal.weight, int(layer.temporal.guide), layer.temporal.warm_start));
   const temporal::ConfidenceParams& c = layer.temporal.confidence_params;
   l.add(
       p + "temporal.confidence",

@@ -60,15 +60,33 @@ class MemoryStore : public Store {
       std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
     layers[{l.name, f}] = std::move(img);
   }
+  void write_field(const Layer& l, int f, ImageView<const int32_t> nnf, uint64_t digest) override {
+    Image<int32_t> img(nnf.width, nnf.height, 2);
+    for (int y = 0; y < nnf.height; ++y)
+      std::memcpy(img.row(y), nnf.row(y), sizeof(int32_t) * 2 * nnf.width);
+    fields[{l.name, f}] = {digest, std::move(img)};
+  }
+  Image<int32_t> read_field(const Layer& l, int f, uint64_t digest) const override {
+    const auto it = fields.find({l.name, f});
+    if (it == fields.end() || it->second.first != digest) return {};
+    return it->second.second.clone();
+  }
   bool has_frame(int f) const override { return frames.count(f) > 0; }
   void write_frame(int f, ImageView<const float> c, const std::vector<ImageView<const float>>&,
                    ImageView<const float>) override {
     frames[f] = c(c.width / 2, c.height / 2, 0);
   }
   std::map<std::pair<std::string, int>, Image<float>> layers;
+  std::map<std::pair<std::string, int>, std::pair<uint64_t, Image<int32_t>>> fields;
   std::map<int, float> frames;
   mutable int reads = 0;
 };
+
+bool same_layer(const MemoryStore& a, const MemoryStore& b, int f) {
+  const Image<float>& x = a.layers.at({"base", f});
+  const Image<float>& y = b.layers.at({"base", f});
+  return x.bytes() == y.bytes() && std::memcmp(x.row(0), y.row(0), x.bytes()) == 0;
+}
 
 Shot tiny_shot() {
   Shot s;
@@ -216,6 +234,42 @@ TEST(Pipeline, RunsResumesAndContinuesTheChain) {
   EXPECT_EQ(r.first_frame, 0);
   EXPECT_EQ(r.synthesized, 4);
   EXPECT_EQ(r.composited, 1);
+}
+
+TEST(Pipeline, WarmStartResumesFromTheStoredFieldOnly) {
+  const Shot shot = tiny_shot();
+  const SlidingFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  MemoryStore full;
+  run_shot(shot, frames, ex, CompositeInputs{}, full, RunOptions{});
+  ASSERT_EQ(full.fields.size(), 4u);  // every frame keeps its field for the next one
+  EXPECT_EQ(full.fields.at({"base", 1}).first, value_digest(full.layers.at({"base", 1}).cview()));
+
+  // Frames 0-1 finished; the resumed frame 2 starts from frame 1's stored field, as it did in
+  // the uninterrupted run.
+  RunOptions o;
+  o.last_frame = 1;
+  MemoryStore part;
+  run_shot(shot, frames, ex, CompositeInputs{}, part, o);
+  MemoryStore stale;  // the same, with a field that belongs to another value
+  run_shot(shot, frames, ex, CompositeInputs{}, stale, o);
+  stale.fields.at({"base", 1}).first ^= 1;
+  o.last_frame = -1;
+  run_shot(shot, frames, ex, CompositeInputs{}, part, o);
+  run_shot(shot, frames, ex, CompositeInputs{}, stale, o);
+  EXPECT_TRUE(same_layer(full, part, 2));
+  EXPECT_TRUE(same_layer(full, part, 3));
+  // A field that does not match is not used: frame 2 runs the whole pyramid (and differs).
+  EXPECT_FALSE(same_layer(full, stale, 2));
+
+  // Without the warm start every frame runs the whole pyramid: the frames after the first differ.
+  Shot cold_shot = shot;
+  cold_shot.layers[0].temporal.warm_start = false;
+  MemoryStore cold;
+  run_shot(cold_shot, frames, ex, CompositeInputs{}, cold, RunOptions{});
+  EXPECT_TRUE(cold.fields.empty());
+  EXPECT_TRUE(same_layer(full, cold, 0));
+  EXPECT_FALSE(same_layer(full, cold, 2));
 }
 
 TEST(Pipeline, TemporalGuideChangesFramesAfterTheFirst) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
@@ -32,6 +33,20 @@ class Store {
   // The layer's values (1 or 3 channels) and, for a masked layer, the mask coverage last.
   virtual Image<float> read_layer(const Layer& layer, int frame) const = 0;
   virtual void write_layer(const Layer& layer, int frame, ImageView<const float> value) = 0;
+  // A temporal layer's field at `frame` (the next frame's warm start) with the digest of the
+  // value it made (value_digest()), kept so that a resumed run starts the next frame from it
+  // exactly as an uninterrupted run does. Written before write_layer (whose file marks the frame
+  // finished). read_field gives an empty image when there is none, or when what is there is not
+  // that frame's field of a value with `digest` and the shot's size (the next frame then runs
+  // the whole pyramid). The defaults keep nothing.
+  virtual void write_field(const Layer& layer, int frame, ImageView<const int32_t> nnf,
+                           uint64_t digest) {
+    (void)layer, (void)frame, (void)nnf, (void)digest;
+  }
+  virtual Image<int32_t> read_field(const Layer& layer, int frame, uint64_t digest) const {
+    (void)layer, (void)frame, (void)digest;
+    return {};
+  }
   // True when every per-frame output (composite, layered EXR, ...) of `frame` exists.
   virtual bool has_frame(int frame) const = 0;
   // `composite` is RGBA; `layers` are in shot.layers order.
@@ -70,6 +85,10 @@ struct CompositeInputs {
 
 // Painted guide weight maps (GuideSpec::map_image) by path: one channel each, the shot's size.
 using WeightMapImages = std::map<std::string, Image<float>>;
+
+// A digest of a layer value's samples (bit patterns, size and channels), which ties a stored
+// field to the value it made.
+uint64_t value_digest(ImageView<const float> value);
 
 // Runs (or resumes) the shot over the requested frames and layers. `exemplars` maps exemplar
 // names to their images; `weight_maps` holds every painted weight map the layers name. Throws

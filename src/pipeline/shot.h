@@ -120,6 +120,10 @@ struct TemporalSpec {
   // the temporal guide holding the layout, the term only pushes the exemplar's least used
   // patches into wherever that guide is weakest, where the chain then keeps them.
   float uniformity = 0.0f;
+  // The main transfer at a temporal frame starts at the finest pyramid level from the previous
+  // frame's field carried along the advection, instead of the whole pyramid from a random field
+  // (docs/temporal.md). Off: every frame runs the whole pyramid, as before it existed.
+  bool warm_start = true;
 };
 
 struct SynthSpec {

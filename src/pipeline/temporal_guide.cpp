@@ -23,13 +23,32 @@ uint64_t frame_seed(const Layer& l, int frame, int transfer) {
 
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
+  if (const temporal::AdvectionField* f = find(l, frame)) return *f;
+  entries_.push_back(std::make_unique<Entry>(
+      Entry{l.temporal.guide, l.synth.patch_size, frame_seed(l, frame, 1), compute()}));
+  return entries_.back()->field;
+}
+
+const temporal::AdvectionField* AdvectionFields::find(const Layer& l, int frame) const {
   const uint64_t seed = frame_seed(l, frame, 1);
   for (const auto& e : entries_)
     if (e->guide == l.temporal.guide && e->patch_size == l.synth.patch_size && e->seed == seed)
-      return e->field;
-  entries_.push_back(
-      std::make_unique<Entry>(Entry{l.temporal.guide, l.synth.patch_size, seed, compute()}));
-  return entries_.back()->field;
+      return &e->field;
+  return nullptr;
+}
+
+Image<int32_t> carry_field(ImageView<const int32_t> previous, const temporal::AdvectionField& f) {
+  const int w = f.nnf.width(), h = f.nnf.height();
+  if (previous.width != w || previous.height != h || previous.channels != 2) return {};
+  Image<int32_t> out(w, h, 2);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int32_t qx = f.nnf(x, y, 0), qy = f.nnf(x, y, 1);
+      const bool inside = qx >= 0 && qx < w && qy >= 0 && qy < h;
+      out(x, y, 0) = inside ? previous(qx, qy, 0) : -1;
+      out(x, y, 1) = inside ? previous(qx, qy, 1) : -1;
+    }
+  return out;
 }
 
 temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,

@@ -30,6 +30,8 @@ class AdvectionFields {
  public:
   const temporal::AdvectionField& get(const Layer& layer, int frame,
                                       const std::function<temporal::AdvectionField()>& compute);
+  // The field get() gave `layer` at `frame`, or null when it has not been computed.
+  const temporal::AdvectionField* find(const Layer& layer, int frame) const;
 
  private:
   struct Entry {
@@ -50,5 +52,13 @@ temporal::Advection advect_layer(const Layer& layer, ImageView<const float> pass
                                  const Image<float>& mask, ImageView<const float> previous,
                                  ImageView<const float> previous_passes, int frame,
                                  AdvectionFields* fields = nullptr);
+
+// The warm start of a layer's main transfer at a frame (TemporalSpec::warm_start): `previous`,
+// its field at the frame before (Result::nnf: the exemplar patch centre per pixel, (-1, -1)
+// where it was not synthesized), carried along the frame's advection `field`. Pixel p starts at
+// the exemplar patch that the pixel of t-1 it matches used; where that pixel had none, at
+// (-1, -1), which the synthesizer draws at random. Empty when the sizes disagree.
+Image<int32_t> carry_field(ImageView<const int32_t> previous,
+                           const temporal::AdvectionField& field);
 
 }  // namespace emaki::pipeline

@@ -131,6 +131,7 @@ void validate(const Inputs& in, const Params& p) {
   if (p.patch_match_iters < -1) throw Error(F{"patch_match_iters"}, "must be >= 0");
   if (p.search_radius < 0) throw Error(F{"search_radius"}, "must be >= 0 (0: the whole exemplar)");
   if (!std::isfinite(p.style_weight)) throw Error(F{"style_weight"}, "must be finite");
+  if (p.finest_search_vote_iters < -1) throw Error(F{"finest_search_vote_iters"}, "must be >= 0");
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
   const int ns = plane_channels(in.style);
@@ -172,6 +173,10 @@ void validate(const Inputs& in, const Params& p) {
     throw Error(first_target, fmt::format("target {}x{} is smaller than the {}x{} patch", tw, th,
                                           p.patch_size, p.patch_size));
   check_weight_maps(in, p, tw, th);
+  const ImageView<const int32_t>& init = p.initial_nnf;
+  if (!init.empty() && (init.width != tw || init.height != th || init.channels != 2))
+    throw Error(F{"initial_nnf"}, fmt::format("is {}x{}x{}, the target {}x{}x2", init.width,
+                                              init.height, init.channels, tw, th));
   if (in.target_mask) {
     if (plane_width(*in.target_mask) != tw || plane_height(*in.target_mask) != th)
       throw Error(in.target_mask_name,
@@ -303,10 +308,23 @@ void write_style(const Image<float>& style, const FeatureLayout& L, Image<int16_
   pad_replicate(tgt, border, 0, ns);
 }
 
+// The warm start's field: `given` where its patch lies inside the source, a random draw
+// elsewhere.
+Image<int32_t> warm_nnf(ImageView<const int32_t> given, int sw, int sh, int r, uint64_t seed) {
+  Image<int32_t> out = random_nnf(given.width, given.height, sw, sh, r, seed);
+  for (int y = 0; y < given.height; ++y)
+    for (int x = 0; x < given.width; ++x) {
+      const int32_t sx = given(x, y, 0), sy = given(x, y, 1);
+      if (sx >= r && sx < sw - r && sy >= r && sy < sh - r) out(x, y, 0) = sx, out(x, y, 1) = sy;
+    }
+  return out;
+}
+
 }  // namespace
 
 struct Synthesizer::State {
   Params params;
+  Image<int32_t> initial_nnf;  // the warm start's field (Params::initial_nnf), or empty
   Plane style;
   std::optional<Plane> mask;
   int sw = 0, sh = 0, tw = 0, th = 0, levels = 0, border = 0;
@@ -336,6 +354,10 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
 
   int levels = max_pyramid_levels(sw, sh, tw, th, p);
   if (params.pyramid_levels > 0) levels = std::min(levels, params.pyramid_levels);
+  if (!params.initial_nnf.empty()) {
+    levels = 1;  // a warm start refines the given field at the finest level only
+    st.initial_nnf = warm_nnf(params.initial_nnf, sw, sh, r, params.seed);
+  }
   st.levels = levels;
   st.schedule = make_schedule(params, levels);
 
@@ -427,7 +449,7 @@ struct Solve {
   PatchSsdFn ssd;
   // Cancellation (Params::cancel), polled on this thread before each level and each sweep.
   std::function<void()> poll;
-  Image<int32_t> nnf;
+  Image<int32_t> nnf;  // holds the warm start's field (if any) until the level starts
   Image<float> err;
   Image<float> style;
 
@@ -451,16 +473,17 @@ struct Solve {
     return cfg;
   }
 
-  // The level's starting field (identity or random at the coarsest level, the coarser field
-  // upscaled below it) and a plain vote from it, so the first search sees a target style.
+  // The level's starting field (the warm start's, identity or random at the coarsest level, the
+  // coarser field upscaled below it) and a plain vote from it, so the first search sees a target
+  // style.
   void start_level(Level& L, int l, bool coarsest) {
     const int p = params.patch_size, r = p / 2;
-    if (coarsest)
+    if (!coarsest)
+      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
+    else if (nnf.empty())  // else it holds the warm start's field
       nnf = params.init == FieldInit::kIdentity
                 ? identity_nnf(L.tw, L.th, L.sw, L.sh, r)
                 : random_nnf(L.tw, L.th, L.sw, L.sh, r, params.seed);
-    else
-      nnf = upscale_nnf(nnf, L.tw, L.th, L.sw, L.sh, r);
     err.reset(L.tw, L.th, 1);
     if (!L.weight_maps.empty()) L.group_weights = quantize_group_weights(L.weight_maps);
     vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
@@ -538,6 +561,7 @@ Result Synthesizer::run(const OutputRequest& request) {
   build_coarse_levels(pyr, st.style, st.sw, st.sh, st.layout, st.border);
 
   Solve solve{params, st.layout, st.style, st.border, best_patch_ssd(), {}, {}, {}, {}};
+  solve.nnf = std::move(st.initial_nnf);
   solve.poll = [&params] {
     if (params.cancel && params.cancel()) throw Cancelled();
   };

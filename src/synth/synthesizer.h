@@ -92,6 +92,13 @@ struct Params {
   FieldInit init = FieldInit::kRandom;
   // emaki's schedule only: search-vote iterations at the finest level (-1: the schedule's 2).
   int finest_search_vote_iters = -1;
+  // Optional warm start: the finest level's starting field, the target's size, 2 channels (the
+  // source patch centre x, y, as Result::nnf gives it; the caller's, read only by the
+  // constructor). With it the run is the finest level alone (pyramid_levels is taken as 1, so
+  // the schedule is that of the finest level) and `init` does not count. An entry whose patch
+  // leaves the source (such as Result::nnf's (-1, -1) outside a mask) starts at a random draw
+  // keyed by `seed` and the pixel, as FieldInit::kRandom would.
+  ImageView<const int32_t> initial_nnf = {};
   bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
   VoteMode vote_mode = VoteMode::kWeighted;
   uint64_t seed = 1;

@@ -128,6 +128,60 @@ TEST(Synthesize, BitIdenticalForAnyThreadCountAndRun) {
   }
 }
 
+// A warm start runs the finest level alone from the given field: a converged field given back,
+// with no search, gives back its image; entries whose patch leaves the source (a mask's (-1, -1),
+// values from a hostile file) start at random draws; thread counts do not matter.
+TEST(Synthesize, WarmStartFromAGivenField) {
+  Fixture f;
+  f.style = noise(64, 48, 1, 4);
+  f.guide_src = textured(64, 48, 5);
+  f.guide_tgt = textured(72, 40, 6);
+  Params params;
+  OutputRequest req;
+  req.nnf = true;
+  const Result cold = synthesize(f.inputs(), params, req);
+  ASSERT_GT(cold.pyramid_levels, 1);
+
+  Params warm = params;
+  warm.initial_nnf = cold.nnf.cview();
+  warm.finest_search_vote_iters = 0;
+  Result again = synthesize(f.inputs(), warm, req);
+  EXPECT_EQ(again.pyramid_levels, 1);
+  for (int y = 0; y < 40; ++y)
+    ASSERT_EQ(0, std::memcmp(again.nnf.row(y), cold.nnf.row(y), 72 * 2 * 4)) << y;
+
+  Image<int32_t> hostile = cold.nnf.clone();
+  const int32_t junk[][2] = {{-1, -1}, {0, 0}, {63, 47}, {1 << 30, -5}, {INT32_MIN, INT32_MAX}};
+  for (int i = 0; i < 5; ++i)
+    hostile(7 * i, 3 * i, 0) = junk[i][0], hostile(7 * i, 3 * i, 1) = junk[i][1];
+  warm.initial_nnf = hostile.cview();
+  again = synthesize(f.inputs(), warm, req);
+  const int r = params.patch_size / 2;
+  for (int i = 0; i < 5; ++i) {
+    const int x = again.nnf(7 * i, 3 * i, 0), y = again.nnf(7 * i, 3 * i, 1);
+    EXPECT_TRUE(x >= r && x < 64 - r && y >= r && y < 48 - r) << i << ": " << x << ", " << y;
+  }
+
+  warm.finest_search_vote_iters = 1;
+  std::vector<Result> results;
+  for (int threads : {1, 2, 3}) {
+    set_thread_count(threads);
+    results.push_back(synthesize(f.inputs(), warm, req));
+  }
+  set_thread_count(0);
+  for (std::size_t i = 1; i < results.size(); ++i)
+    EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
+
+  Image<int32_t> small(71, 40, 2);
+  warm.initial_nnf = small.cview();
+  try {
+    synthesize(f.inputs(), warm);
+    ADD_FAILURE() << "a field of the wrong size was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("initial_nnf"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Synthesize, SeedChangesTheResult) {
   Fixture f;
   f.style = noise(64, 48, 1, 4);
