@@ -116,7 +116,9 @@ TEST(Advection, OneFieldServesLayersWithOtherValuesAndMasks) {
       const Image<float> alone = advect(in, p).value, shared = advect(in, p, &field).value;
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) ASSERT_EQ(alone(x, y), shared(x, y)) << x << "," << y;
-      if (masked) EXPECT_EQ(shared(0, 0), in.empty_value);  // outside the mask
+      if (masked) {
+        EXPECT_EQ(shared(0, 0), in.empty_value);  // outside the mask
+      }
     }
 }
 
