@@ -83,21 +83,27 @@ struct Band {
   int dirty_stride;
 };
 
-// Zeroes the delta in every dirty block and the dirty map: cheaper than undoing each change
-// (most bands touch a small part of the source, and a change costs four triangles to undo).
-void clear_band(Band& band, int sw, int sh) {
+// Adds a band's occupancy delta to the window sums `occ` (when not null) and zeroes it, over the
+// rows of 8x8 blocks [by0, by1), touching only the blocks the band dirtied. The delta is the exact
+// change of the sums, so folding it in equals recomputing them from the field.
+void fold_band(DeltaBuffers& buf, int dirty_stride, int32_t* occ, int sw, int sh, int by0,
+               int by1) {
   const int bw = (sw + (1 << kDirtyShift) - 1) >> kDirtyShift;
-  const int bh = (sh + (1 << kDirtyShift) - 1) >> kDirtyShift;
-  for (int by = 0; by < bh; ++by)
+  for (int by = by0; by < by1; ++by)
     for (int bx = 0; bx < bw; ++bx) {
-      uint8_t& d = band.dirty[by * band.dirty_stride + bx];
+      uint8_t& d = buf.dirty[std::size_t(by) * dirty_stride + bx];
       if (!d) continue;
       d = 0;
       const int x0 = bx << kDirtyShift, x1 = std::min(sw, x0 + (1 << kDirtyShift));
       const int y0 = by << kDirtyShift, y1 = std::min(sh, y0 + (1 << kDirtyShift));
-      for (int y = y0; y < y1; ++y)
-        std::fill(band.delta + std::ptrdiff_t(y) * sw + x0,
-                  band.delta + std::ptrdiff_t(y) * sw + x1, 0);
+      for (int y = y0; y < y1; ++y) {
+        int32_t* delta = buf.delta.data() + std::ptrdiff_t(y) * sw;
+        int32_t* sums = occ ? occ + std::ptrdiff_t(y) * sw : nullptr;
+        for (int x = x0; x < x1; ++x) {
+          if (sums) sums[x] += delta[x];
+          delta[x] = 0;
+        }
+      }
     }
 }
 
@@ -302,36 +308,40 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   const int bands = (L.th + band - 1) / band;
   static_assert(kRounds >= 2);
   const int rounds = std::min(bands, kRounds);
+  // The window sums are computed once; each round's deltas are folded into them afterwards.
   std::vector<int32_t> occ, occ_scratch;
+  if (occ_scale > 0.0f)
+    occupancy_window_sums(L, p, occ, occ_scratch);
+  else
+    occ.assign(std::size_t(L.sw) * L.sh, 0);
+  const Sweep sweep{L,
+                    C,
+                    occ.data(),
+                    occ_scale,
+                    p / 2,
+                    L.src->stride(),
+                    p * L.src->channels(),
+                    1.0 / C.err_scale};
+  const int block_rows = (L.sh + (1 << kDirtyShift) - 1) >> kDirtyShift;
   for (int iter = 0; iter < C.iterations; ++iter) {
     if (C.before_sweep) (*C.before_sweep)();
     for (int round = 0; round < rounds; ++round) {
-      if (occ_scale > 0.0f)
-        occupancy_window_sums(L, p, occ, occ_scratch);
-      else
-        occ.assign(std::size_t(L.sw) * L.sh, 0);
-      const Sweep sweep{L,
-                        C,
-                        occ.data(),
-                        occ_scale,
-                        p / 2,
-                        L.src->stride(),
-                        p * L.src->channels(),
-                        1.0 / C.err_scale};
       const int in_round = (bands - round + rounds - 1) / rounds;
+      std::vector<DeltaBuffers> used(in_round);
       parallel_for(in_round, 1, [&](int64_t i0, int64_t i1) {
         for (int64_t i = i0; i < i1; ++i) {
           const int b = round + int(i) * rounds;
-          Band bd;
-          auto buf = pool.take();
-          bd.delta = buf.delta.data();
-          bd.dirty = buf.dirty.data();
-          bd.dirty_stride = dirty_stride;
+          used[i] = pool.take();
+          Band bd{used[i].delta.data(), used[i].dirty.data(), dirty_stride};
           sweep_band(sweep, bd, b * band, std::min(L.th, (b + 1) * band), iter);
-          clear_band(bd, L.sw, L.sh);  // the buffer goes back to the pool zeroed
-          pool.give(std::move(buf));
         }
       });
+      parallel_for(block_rows, 8, [&](int64_t by0, int64_t by1) {
+        for (auto& buf : used)
+          fold_band(buf, dirty_stride, occ_scale > 0.0f ? occ.data() : nullptr, L.sw, L.sh,
+                    int(by0), int(by1));
+      });
+      for (auto& buf : used) pool.give(std::move(buf));  // zeroed by the fold
     }
   }
 }
