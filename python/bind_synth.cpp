@@ -49,9 +49,9 @@ Args:
     patch_size: odd, [3, 65]. Default 5.
     pyramid_levels: [1, 32]; None (default): as many as fit.
     search_vote_iters: search-vote iterations at every level, [0, 1000]; None (default):
-        emaki's schedule (6 at coarse levels; 3, 2, 2 at the three finest).
+        emaki's schedule (6 at coarse levels; 2, 2 at the two finest).
     patch_match_iters: PatchMatch iterations per search-vote iteration, [0, 1000]; None
-        (default): emaki's schedule (4 at coarse levels; 3, 3, 2 at the three finest).
+        (default): emaki's schedule (4 at coarse levels; 3, 2 at the two finest).
     extra_pass_3x3: a final polishing pass with 3x3 patches. Default False.
     vote: 'weighted' (default) or 'plain'.
     seed: random seed, [0, 2**64 - 1]. Default 1.

@@ -40,9 +40,9 @@ EbSynth options (single dash)
   -patchsize N          patch size, odd, >= 3. Default: 5
   -pyramidlevels N      pyramid levels, >= 1. Default: as many as fit
   -searchvoteiters N    search-vote iterations per level, >= 0. Default: emaki's schedule
-                        (6 at coarse levels; 3, 2, 2 at the three finest)
+                        (6 at coarse levels; 2, 2 at the two finest)
   -patchmatchiters N    PatchMatch iterations per search-vote iteration, >= 0. Default: emaki's
-                        schedule (4 at coarse levels; 3, 3, 2 at the three finest)
+                        schedule (4 at coarse levels; 3, 2 at the two finest)
   -stopthreshold N      accepted for compatibility; no effect (as in EbSynth's CPU backend)
   -extrapass3x3         a final polishing pass with 3x3 patches. Default: off
   -backend cpu|cuda|auto  accepted for compatibility; emaki always runs on the CPU

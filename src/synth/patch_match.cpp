@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <mutex>
 #include <vector>
@@ -66,10 +65,8 @@ class DeltaPool {
 struct Sweep {
   const PatchMatchLevel& L;
   const PatchMatchConfig& C;
-  const int32_t* occ;                 // snapshot window sums, sw x sh
-  const Image<int32_t>& snap;         // rows next to band edges as they were when the sweep began
-  const std::vector<int>& snap_slot;  // target row -> row of snap (-1: not kept)
-  float occ_scale;                    // uniformity / (p^2 * omega_best)
+  const int32_t* occ;  // window sums as the round began, sw x sh
+  float occ_scale;     // uniformity / (p^2 * omega_best)
   int r;
   std::ptrdiff_t src_stride;
   int row_elems;
@@ -84,8 +81,31 @@ struct Band {
   int32_t* delta;
   uint8_t* dirty;  // per block: has the delta any non-zero value there
   int dirty_stride;
-  std::vector<int32_t> changes;  // (centre x, centre y, sign) triples to undo the delta afterwards
 };
+
+// Adds a band's occupancy delta to the window sums `occ` (when not null) and zeroes it, over the
+// rows of 8x8 blocks [by0, by1), touching only the blocks the band dirtied. The delta is the exact
+// change of the sums, so folding it in equals recomputing them from the field.
+void fold_band(DeltaBuffers& buf, int dirty_stride, int32_t* occ, int sw, int sh, int by0,
+               int by1) {
+  const int bw = (sw + (1 << kDirtyShift) - 1) >> kDirtyShift;
+  for (int by = by0; by < by1; ++by)
+    for (int bx = 0; bx < bw; ++bx) {
+      uint8_t& d = buf.dirty[std::size_t(by) * dirty_stride + bx];
+      if (!d) continue;
+      d = 0;
+      const int x0 = bx << kDirtyShift, x1 = std::min(sw, x0 + (1 << kDirtyShift));
+      const int y0 = by << kDirtyShift, y1 = std::min(sh, y0 + (1 << kDirtyShift));
+      for (int y = y0; y < y1; ++y) {
+        int32_t* delta = buf.delta.data() + std::ptrdiff_t(y) * sw;
+        int32_t* sums = occ ? occ + std::ptrdiff_t(y) * sw : nullptr;
+        for (int x = x0; x < x1; ++x) {
+          if (sums) sums[x] += delta[x];
+          delta[x] = 0;
+        }
+      }
+    }
+}
 
 inline float occupancy(const Sweep& S, const Band& band, int cx, int cy) {
   const std::ptrdiff_t i = std::ptrdiff_t(cy) * S.L.sw + cx;
@@ -146,7 +166,6 @@ inline void try_candidate(const Sweep& S, Band& band, int x, int y, int cx, int 
     add_triangle(band.delta, L.sw, L.sh, cx, cy, p, +1);
     mark_dirty(band, L.sw, L.sh, n[0], n[1], p);
     mark_dirty(band, L.sw, L.sh, cx, cy, p);
-    band.changes.insert(band.changes.end(), {n[0], n[1], -1, cx, cy, +1});
     cur_occ = occupancy(S, band, cx, cy);
   }
   n[0] = cx;
@@ -201,9 +220,8 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
         }
         const int ny = y - q;
         if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
-          // Across the band edge, read the field as it was when the sweep began.
-          const bool inside = ny >= y0 && ny < y1;
-          const int32_t* m = inside ? L.nnf->at(x, ny) : S.snap.at(x, S.snap_slot[ny]);
+          // Across the band edge the neighbouring band is not being swept in this round.
+          const int32_t* m = L.nnf->at(x, ny);
           const int cy = m[1] + q;
           if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, x, y, m[0], cy, cur_occ);
         }
@@ -286,50 +304,45 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
 
   const int dirty_stride = (L.sw >> kDirtyShift) + 1;
   DeltaPool pool(std::size_t(L.sw) * L.sh, std::size_t(dirty_stride) * ((L.sh >> kDirtyShift) + 1));
-  // Only the rows on either side of a band edge are read across bands: keep just those.
   const int band = band_rows(L.th);
-  std::vector<int> snap_slot(L.th, -1), snap_rows;
-  for (int e = band; e < L.th; e += band) {
-    snap_slot[e - 1] = int(snap_rows.size());
-    snap_rows.push_back(e - 1);
-    snap_slot[e] = int(snap_rows.size());
-    snap_rows.push_back(e);
-  }
-  Image<int32_t> snap(L.tw, std::max<int>(1, int(snap_rows.size())), 2);
+  const int bands = (L.th + band - 1) / band;
+  static_assert(kRounds >= 2);
+  const int rounds = std::min(bands, kRounds);
+  // The window sums are computed once; each round's deltas are folded into them afterwards.
   std::vector<int32_t> occ, occ_scratch;
+  if (occ_scale > 0.0f)
+    occupancy_window_sums(L, p, occ, occ_scratch);
+  else
+    occ.assign(std::size_t(L.sw) * L.sh, 0);
+  const Sweep sweep{L,
+                    C,
+                    occ.data(),
+                    occ_scale,
+                    p / 2,
+                    L.src->stride(),
+                    p * L.src->channels(),
+                    1.0 / C.err_scale};
+  const int block_rows = (L.sh + (1 << kDirtyShift) - 1) >> kDirtyShift;
   for (int iter = 0; iter < C.iterations; ++iter) {
     if (C.before_sweep) (*C.before_sweep)();
-    for (std::size_t k = 0; k < snap_rows.size(); ++k)
-      std::memcpy(snap.row(int(k)), L.nnf->row(snap_rows[k]),
-                  std::size_t(L.tw) * 2 * sizeof(int32_t));
-    if (occ_scale > 0.0f)
-      occupancy_window_sums(L, p, occ, occ_scratch);
-    else
-      occ.assign(std::size_t(L.sw) * L.sh, 0);
-    const Sweep sweep{L,
-                      C,
-                      occ.data(),
-                      snap,
-                      snap_slot,
-                      occ_scale,
-                      p / 2,
-                      L.src->stride(),
-                      p * L.src->channels(),
-                      1.0 / C.err_scale};
-    parallel_rows(L.th, band, [&](int y0, int y1) {
-      Band band;
-      auto buf = pool.take();
-      band.delta = buf.delta.data();
-      band.dirty = buf.dirty.data();
-      band.dirty_stride = dirty_stride;
-      sweep_band(sweep, band, y0, y1, iter);
-      // Undo this band's changes so the buffer goes back to the pool zeroed.
-      for (std::size_t i = 0; i < band.changes.size(); i += 3)
-        add_triangle(band.delta, L.sw, L.sh, band.changes[i], band.changes[i + 1], p,
-                     -band.changes[i + 2]);
-      std::fill(buf.dirty.begin(), buf.dirty.end(), uint8_t(0));
-      pool.give(std::move(buf));
-    });
+    for (int round = 0; round < rounds; ++round) {
+      const int in_round = (bands - round + rounds - 1) / rounds;
+      std::vector<DeltaBuffers> used(in_round);
+      parallel_for(in_round, 1, [&](int64_t i0, int64_t i1) {
+        for (int64_t i = i0; i < i1; ++i) {
+          const int b = round + int(i) * rounds;
+          used[i] = pool.take();
+          Band bd{used[i].delta.data(), used[i].dirty.data(), dirty_stride};
+          sweep_band(sweep, bd, b * band, std::min(L.th, (b + 1) * band), iter);
+        }
+      });
+      parallel_for(block_rows, 8, [&](int64_t by0, int64_t by1) {
+        for (auto& buf : used)
+          fold_band(buf, dirty_stride, occ_scale > 0.0f ? occ.data() : nullptr, L.sw, L.sh,
+                    int(by0), int(by1));
+      });
+      for (auto& buf : used) pool.give(std::move(buf));  // zeroed by the fold
+    }
   }
 }
 
