@@ -117,9 +117,11 @@ struct TemporalSpec {
   bool confidence = true;
   temporal::ConfidenceParams confidence_params;  // not in the shot file: measured defaults
   // The main transfer's uniformity at temporal frames (the first frame uses SynthSpec's): with
-  // the temporal guide holding the layout, the term only pushes the exemplar's least used
-  // patches into wherever that guide is weakest, where the chain then keeps them.
-  float uniformity = 0.0f;
+  // the temporal guide holding the layout, the term pushes the exemplar's least used patches
+  // into wherever that guide is weakest, where the chain then keeps them (a pale streak behind
+  // a moving object at 3500); without it the chain settles into flat, textureless regions. 1000
+  // is the middle measured on the example (docs/temporal.md).
+  float uniformity = 1000.0f;
   // The main transfer at a temporal frame starts at the finest pyramid level from the previous
   // frame's field carried along the advection, instead of the whole pyramid from a random field
   // (docs/temporal.md). Off: every frame runs the whole pyramid, as before it existed.

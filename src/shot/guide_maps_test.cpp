@@ -102,7 +102,7 @@ TEST_F(GuideMaps, PaintedMapMustHaveTheShotsSize) {
 
 TEST_F(GuideMaps, TemporalConfidenceIsOnUnlessTurnedOff) {
   EXPECT_TRUE(parse_shot(shot_text(""), shot_path()).layers[0].temporal.confidence);
-  EXPECT_EQ(parse_shot(shot_text(""), shot_path()).layers[0].temporal.uniformity, 0.0f);
+  EXPECT_EQ(parse_shot(shot_text(""), shot_path()).layers[0].temporal.uniformity, 1000.0f);
   EXPECT_EQ(parse_shot(shot_text("temporal_uniformity = 3500"), shot_path())
                 .layers[0]
                 .temporal.uniformity,
