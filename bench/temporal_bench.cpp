@@ -19,7 +19,8 @@
 //
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
-// `rest_position_noconf` (temporal_confidence = false); a `_uniform` suffix keeps the layer's
+// `rest_position_noconf` (temporal_confidence = false); a `_cold` suffix runs the whole pyramid at
+// every frame (temporal_warm_start = false); a `_uniform` suffix keeps the layer's
 // uniformity at temporal frames (temporal_uniformity = uniformity, or --temporal-uniformity U),
 // @W gives the variant the
 // temporal weight W (`rest_position_noconf_uniform@1`: the example before the confidence).
@@ -85,10 +86,10 @@ struct Options {
 // A variant's base name: without @WEIGHT and _uniform.
 std::string base_name(const std::string& variant) {
   std::string name = variant.substr(0, variant.find('@'));
-  const std::string uniform = "_uniform";
-  if (name.size() > uniform.size() &&
-      name.compare(name.size() - uniform.size(), uniform.size(), uniform) == 0)
-    name.resize(name.size() - uniform.size());
+  for (const std::string suffix : {"_uniform", "_cold", "_uniform"})
+    if (name.size() > suffix.size() &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+      name.resize(name.size() - suffix.size());
   return name;
 }
 
@@ -251,6 +252,7 @@ pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, con
   l.temporal.guide = name.rfind("position", 0) == 0 ? pipeline::AdvectionGuide::kPosition
                                                     : pipeline::AdvectionGuide::kRestPosition;
   l.temporal.confidence = name.find("_noconf") == std::string::npos;
+  if (variant.find("_cold") != std::string::npos) l.temporal.warm_start = false;
   l.temporal.confidence_params = o.confidence;
   if (o.temporal_weight >= 0.0f) l.temporal.weight = o.temporal_weight;
   if (at != std::string::npos) l.temporal.weight = std::strtof(variant.c_str() + at + 1, nullptr);
