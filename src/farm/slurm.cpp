@@ -1,7 +1,6 @@
 #include "farm/slurm.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
@@ -84,10 +83,9 @@ void append_jobs(const std::string& folder, const std::vector<const Task*>& task
 void record_chunk(const std::string& folder, int chunk) {
   fs::create_directories(folder);
   const std::string path = folder + "/chunk";
-  io::TempFile tmp(path, "farm record");
+  io::TempFile tmp(path, path);
   const std::string text = fmt::format("{}\n", chunk);
-  if (::write(tmp.fd(), text.data(), text.size()) != ssize_t(text.size()))
-    throw Error(path, "cannot record the submission's chunk");
+  tmp.write(text.data(), text.size());
   tmp.commit();
 }
 
@@ -244,9 +242,8 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
       for (const char* sub : {"", "/logs", "/status", "/scripts"})
         fs::create_directories(farm + sub);
       const std::string path = fmt::format("{}/scripts/{}.sh", farm, shot::task_kind_name(kind));
-      io::TempFile tmp(path, "farm script");
-      if (::write(tmp.fd(), script.data(), script.size()) != ssize_t(script.size()))
-        throw Error(path, "cannot write the batch script");
+      io::TempFile tmp(path, path);
+      tmp.write(script.data(), script.size());
       tmp.commit();
       // A task's record starts afresh: no exit code or log of an earlier submission.
       for (const Task* t : tasks)

@@ -1,9 +1,7 @@
 #include "io/file_store.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -105,17 +103,6 @@ struct FieldHeader {
   uint64_t digest = 0;
 };
 static_assert(sizeof(FieldHeader) == 32);
-
-void write_all(int fd, const void* data, std::size_t size, const std::string& path) {
-  const auto* p = static_cast<const char*>(data);
-  std::size_t done = 0;
-  while (done < size) {
-    const ssize_t n = ::write(fd, p + done, size - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw Error(path, "write failed (disk full?)");
-    done += std::size_t(n);
-  }
-}
 
 bool any_frame(const fs::path& dir, const std::string& prefix,
                std::initializer_list<const char*> exts) {
@@ -328,9 +315,9 @@ void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<c
   FieldHeader h;
   h.frame = frame, h.width = nnf.width, h.height = nnf.height, h.digest = digest;
   TempFile tmp(path, path);
-  write_all(tmp.fd(), &h, sizeof h, path);
+  tmp.write(&h, sizeof h);
   for (int y = 0; y < nnf.height; ++y)
-    write_all(tmp.fd(), nnf.row(y), sizeof(int32_t) * 2 * std::size_t(nnf.width), path);
+    tmp.write(nnf.row(y), sizeof(int32_t) * 2 * std::size_t(nnf.width));
   tmp.commit();
 }
 

@@ -78,6 +78,17 @@ TempFile::TempFile(const std::string& target, const std::string& subject)
   ino_ = st.st_ino;
 }
 
+void TempFile::write(const void* data, std::size_t size) {
+  const auto* p = static_cast<const char*>(data);
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd_, p + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw Error(subject_, "write failed (disk full?)");
+    done += std::size_t(n);
+  }
+}
+
 TempFile::~TempFile() {
   if (fd_ >= 0) ::close(fd_);
   if (!committed_) {
@@ -215,13 +226,7 @@ void write_manifest(const std::string& path, const Manifest& m) {
   TempFile tmp(path, path);
   std::string text;
   for (const std::string& line : m) text += line + '\n';
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(tmp.fd(), text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw Error(path, "write failed (disk full?)");
-    done += std::size_t(n);
-  }
+  tmp.write(text.data(), text.size());
   tmp.commit();
 }
 

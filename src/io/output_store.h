@@ -4,6 +4,7 @@
 // manifests (the settings that made an output) so that resuming never trusts stale files.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
@@ -25,6 +26,9 @@ class TempFile {
 
   const std::string& path() const { return path_; }
   int fd() const { return fd_; }
+  // Writes all of `data` (short and interrupted writes retried); throws emaki::Error(subject)
+  // when the file takes no more (a full disk).
+  void write(const void* data, std::size_t size);
   // Gives the descriptor away (e.g. to fdopen); the file is still removed unless committed.
   int release_fd();
   // Renames the finished temporary over the target (a symlink at the target is replaced, not
