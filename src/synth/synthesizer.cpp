@@ -387,19 +387,7 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
           for (int x = 0; x < tw; ++x) inside(x, y) = row[x * mc] > 0.0f ? 1 : 0;
         });
       });
-      f.active.reset(tw, th, 1);
-      parallel_rows(th, 32, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < tw; ++x) {
-            uint8_t v = 0;
-            for (int dy = -r; dy <= r && !v; ++dy)
-              for (int dx = -r; dx <= r && !v; ++dx) {
-                const int xx = x + dx, yy = y + dy;
-                if (xx >= 0 && xx < tw && yy >= 0 && yy < th) v = inside(xx, yy);
-              }
-            f.active(x, y) = v;
-          }
-      });
+      f.active = dilate_mask(inside, r);
     }
   }
 }

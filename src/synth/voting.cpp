@@ -102,4 +102,28 @@ void vote(const Plane& source, const Image<int32_t>& nnf, const Image<float>& er
   std::visit([&](const auto& v) { vote_impl(v, nnf, err, active, patch_size, mode, out); }, source);
 }
 
+Image<uint8_t> dilate_mask(const Image<uint8_t>& inside, int radius) {
+  const int w = inside.width(), h = inside.height(), r = radius;
+  Image<uint8_t> across(w, h, 1), out(w, h, 1);
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 0;
+        for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r) && !v; ++xx)
+          v = inside(xx, y) ? 1 : 0;
+        across(x, y) = v;
+      }
+  });
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 0;
+        for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r) && !v; ++yy)
+          v = across(x, yy);
+        out(x, y) = v;
+      }
+  });
+  return out;
+}
+
 }  // namespace emaki::synth

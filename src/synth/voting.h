@@ -13,4 +13,8 @@ namespace emaki::synth {
 void vote(const Plane& source, const Image<int32_t>& nnf, const Image<float>& err,
           const Image<uint8_t>& active, int patch_size, VoteMode mode, Image<float>& out);
 
+// Where a masked synthesis works (`active` above): the non-zero pixels of `inside` dilated by
+// `radius` in x and y (a square), so that pixels at the mask's edge get whole patches.
+Image<uint8_t> dilate_mask(const Image<uint8_t>& inside, int radius);
+
 }  // namespace emaki::synth

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "core/check.h"
-#include "core/parallel.h"
 #include "synth/voting.h"
 
 namespace emaki::temporal {
@@ -31,30 +30,13 @@ synth::Params field_params(const synth::Params& params, int search_radius, int w
   return p;
 }
 
-// Where a masked synthesis works: the mask (> 0) dilated by the patch radius, so that pixels at
-// its edge get whole patches — the synthesizer's own rule (synth::Inputs::target_mask).
+// Where a masked synthesis works: the mask (> 0) dilated by the patch radius — the
+// synthesizer's own rule (synth::Inputs::target_mask).
 Image<uint8_t> active_region(ImageView<const float> mask, int r) {
-  const int w = mask.width, h = mask.height;
-  Image<uint8_t> across(w, h, 1), out(w, h, 1);
-  parallel_rows(h, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        uint8_t v = 0;
-        for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r) && !v; ++xx)
-          v = mask.at(xx, y)[0] > 0.0f ? 1 : 0;
-        across(x, y) = v;
-      }
-  });
-  parallel_rows(h, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        uint8_t v = 0;
-        for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r) && !v; ++yy)
-          v = across(x, yy);
-        out(x, y) = v;
-      }
-  });
-  return out;
+  Image<uint8_t> inside(mask.width, mask.height, 1);
+  for (int y = 0; y < mask.height; ++y)
+    for (int x = 0; x < mask.width; ++x) inside(x, y) = mask.at(x, y)[0] > 0.0f ? 1 : 0;
+  return synth::dilate_mask(inside, r);
 }
 
 }  // namespace
