@@ -38,6 +38,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "composite/composite.h"
@@ -86,10 +87,13 @@ struct Options {
 // A variant's base name: without @WEIGHT and _uniform.
 std::string base_name(const std::string& variant) {
   std::string name = variant.substr(0, variant.find('@'));
-  for (const std::string suffix : {"_uniform", "_cold", "_uniform"})
-    if (name.size() > suffix.size() &&
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
-      name.resize(name.size() - suffix.size());
+  // The modifiers, in any order.
+  for (bool stripped = true; stripped;) {
+    stripped = false;
+    for (const std::string_view suffix : {"_uniform", "_cold"})
+      if (name.size() > suffix.size() && name.ends_with(suffix))
+        name.resize(name.size() - suffix.size()), stripped = true;
+  }
   return name;
 }
 
