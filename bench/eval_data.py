@@ -6,11 +6,14 @@ generators use fixed seeds. Only numpy, the standard library, emaki and oiiotool
 """
 
 import os
-import struct
 import subprocess
-import zlib
+import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools",
+                                "hatching"))
+import make_hatching as H  # noqa: E402  (its PNG writer, sRGB decode and box blur)
 
 LIGHT = "0.5,0.6,0.6"  # camera-relative key light: from the upper right, in front, so the
 # sphere shows its whole tonal range
@@ -35,40 +38,18 @@ def read_image(path, tmp_dir):
 
 
 def write_png(path, img):
-    """8-bit RGB PNG (filter 0), img float in [0, 1], HxWx3 or HxW (grey, written as RGB)."""
+    """8-bit RGB PNG, img float in [0, 1], HxWx3 or HxW (grey, written as RGB)."""
     if img.ndim == 2:
         img = np.repeat(img[..., None], 3, axis=2)
-    h, w, _ = img.shape
-    rows = np.clip(np.round(img * 255.0), 0, 255).astype(np.uint8).reshape(h, w * 3)
-    raw = np.concatenate([np.zeros((h, 1), np.uint8), rows], axis=1).tobytes()
-
-    def chunk(kind, body):
-        return (struct.pack(">I", len(body)) + kind + body +
-                struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF))
-
-    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
-           chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
-    with open(path, "wb") as f:
-        f.write(png)
+    H.write_png(path, img, level=6)
 
 
-def srgb_decode(v):
-    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+srgb_decode = H.srgb_decode
 
 
 def blur(img, r):
-    """Separable box filter of radius r applied twice (edge-clamped): close to a Gaussian."""
-    r = max(1, int(r))
-    for _ in range(2):
-        for axis in (0, 1):
-            pad = [(0, 0)] * img.ndim
-            pad[axis] = (r, r)
-            c = np.cumsum(np.pad(img, pad, mode="edge"), axis=axis)
-            c = np.concatenate([np.zeros_like(np.take(c, [0], axis=axis)), c], axis=axis)
-            n = img.shape[axis]
-            img = (np.take(c, np.arange(2 * r + 1, n + 2 * r + 1), axis=axis) -
-                   np.take(c, np.arange(0, n), axis=axis)) / (2 * r + 1)
-    return img
+    """make_hatching's box blur (twice, close to a Gaussian) at radius r, at least 1."""
+    return H.box_blur(img, max(1, int(r)))
 
 
 def smooth_noise(shape, scale, rng):

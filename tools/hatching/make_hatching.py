@@ -30,7 +30,8 @@ import numpy as np
 
 
 # ---------------------------------------------------------------------------------------------
-# PNG in and out (8-bit, non-interlaced), enough for emaki's previews and a grey result
+# PNG in and out (8-bit, non-interlaced), enough for emaki's previews and a grey result (also
+# used by bench/eval_data.py)
 
 
 def read_png(path):
@@ -75,17 +76,19 @@ def read_png(path):
     return img.astype(np.float64) / 255.0
 
 
-def write_grey_png(path, img):
-    h, w = img.shape
-    rows = np.clip(np.round(img * 255.0), 0, 255).astype(np.uint8)
+def write_png(path, img, level=9):
+    """img float in [0, 1]: HxW (grey) or HxWx3 (RGB); filter 0, zlib `level`."""
+    h, w = img.shape[:2]
+    colour = 0 if img.ndim == 2 else 2
+    rows = np.clip(np.round(img * 255.0), 0, 255).astype(np.uint8).reshape(h, -1)
     raw = b"".join(b"\x00" + rows[y].tobytes() for y in range(h))
 
     def chunk(kind, body):
         return (struct.pack(">I", len(body)) + kind + body +
                 struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF))
 
-    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)) +
-           chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0)) +
+           chunk(b"IDAT", zlib.compress(raw, level)) + chunk(b"IEND", b""))
     with open(path, "wb") as f:
         f.write(png)
 
@@ -266,7 +269,7 @@ def main():
     size = [int(v) for v in a.size.split("x")]
     light = [float(v) for v in a.light.split(",")]
     ps = reference_passes(a.emaki, size, light, a.softness, a.elevation, a.fov)
-    write_grey_png(a.out, hatch(ps, light, a.seed, a.spacing))
+    write_png(a.out, hatch(ps, light, a.seed, a.spacing))
     print(f"wrote {a.out}: sphere = [{size[0] / 2}, {size[1] / 2}, {0.3 * size[1]}]")
 
 
