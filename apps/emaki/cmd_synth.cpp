@@ -55,7 +55,8 @@ emaki options
   --guide-weight-map N FILE  per-pixel weight of the N-th -guide (from 1): FILE's first
                         channel, the output's size, values in [0, 1], multiplies the guide's
                         weight at each output pixel (0: the guide does not count there)
-  --vote plain|weighted voting mode. Default: weighted
+  --vote plain|weighted voting mode of the search (weighted: by patch error); the output's
+                        own vote is plain either way. Default: weighted
   --nnf-out FILE        write the nearest-neighbour field (EXR: float x, y of the source patch
                         centre; -1 outside the mask)
   --error-out FILE      write the per-pixel patch error (EXR, EbSynth units)

@@ -59,7 +59,8 @@ inline constexpr int kMaxWeightMaps = 7;
 
 enum class VoteMode {
   kPlain,     // every overlapping patch counts the same
-  kWeighted,  // patches count 1 / (1 + e / 100), e their error per pixel and channel: sharper
+  kWeighted,  // patches count 1 / (1 + e / 100), e their error per pixel and channel: sharper;
+              // the output itself (the run's last vote) is plain
 };
 
 // How the field starts at the coarsest level.
