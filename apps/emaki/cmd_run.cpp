@@ -81,6 +81,13 @@ int run_run(const Args& args) {
                r.report.first_frame, r.report.last_frame, r.report.synthesized, r.report.reused,
                r.report.composited, shot.outputs.folder.c_str());
   for (const std::string& p : r.previews) std::fprintf(stderr, "emaki run: wrote %s\n", p.c_str());
+  for (const pipeline::RunReport::Stale& st : r.report.stale)
+    std::fprintf(stderr,
+                 "emaki run: warning: layer %s: frames %d-%d were made from frame %d as it was "
+                 "before this run changed it; `emaki run %s --force --frames %d-%d --layers %s` "
+                 "redoes them\n",
+                 st.layer.c_str(), st.first, st.last, st.first - 1, c.shot_path.c_str(), st.first,
+                 st.last, st.layer.c_str());
   return 0;
 }
 

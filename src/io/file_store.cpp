@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -10,6 +9,7 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "io/field_file.h"
 #include "io/image_io.h"
 #include "io/shot_manifest.h"
 #include "render/passes.h"
@@ -94,15 +94,6 @@ void remove_layer_frames(const fs::path& dir, const std::string& layer) {
   remove_frames(dir, layer + "_", {".png", ".exr"});
   remove_frames(dir, "." + layer + "_", {".nnf"});
 }
-
-// The field file: this header, then width x height x 2 int32 in the machine's byte order.
-struct FieldHeader {
-  char magic[8] = {'E', 'M', 'A', 'K', 'I', 'N', 'N', 'F'};
-  uint32_t version = 1;
-  int32_t frame = 0, width = 0, height = 0;
-  uint64_t digest = 0;
-};
-static_assert(sizeof(FieldHeader) == 32);
 
 bool any_frame(const fs::path& dir, const std::string& prefix,
                std::initializer_list<const char*> exts) {
@@ -299,10 +290,6 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
   exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
   exr.channel_names = value_names("", value.channels, n);
   write_image(paths_.layer_exr(layer.name, frame), value, exr);
-  // Frame `frame` is finished: the field of the frame before has done its work (a resumed run
-  // continues from this frame's), and at 8 bytes a pixel it is not worth its disk.
-  std::error_code ec;
-  fs::remove(paths_.layer_field(layer.name, frame - 1), ec);
 }
 
 void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
@@ -312,12 +299,9 @@ void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<c
   make_current(layers_.at(layer.name), (fs::path(paths_.folder) / "layers" / layer.name).string(),
                [&](const std::string& dir) { remove_layer_frames(dir, layer.name); });
   const std::string path = paths_.layer_field(layer.name, frame);
-  FieldHeader h;
-  h.frame = frame, h.width = nnf.width, h.height = nnf.height, h.digest = digest;
+  const std::string bytes = encode_field(frame, nnf, digest);
   TempFile tmp(path, path);
-  tmp.write(&h, sizeof h);
-  for (int y = 0; y < nnf.height; ++y)
-    tmp.write(nnf.row(y), sizeof(int32_t) * 2 * std::size_t(nnf.width));
+  tmp.write(bytes.data(), bytes.size());
   tmp.commit();
 }
 
@@ -325,23 +309,20 @@ Image<int32_t> FileStore::read_field(const pipeline::Layer& layer, int frame,
                                      uint64_t digest) const {
   if (!layer_state(layer).current) return {};
   const std::string path = paths_.layer_field(layer.name, frame);
-  const int w = shot_.source.width, h = shot_.source.height;
-  const std::size_t row_bytes = sizeof(int32_t) * 2 * std::size_t(w);
+  const FieldKey want{frame, shot_.source.width, shot_.source.height, digest};
   std::error_code ec;
-  // The size first: nothing is allocated for a file that cannot be this frame's field.
-  if (!fs::is_regular_file(path, ec) ||
-      fs::file_size(path, ec) != sizeof(FieldHeader) + row_bytes * std::size_t(h) || ec)
+  // The size first: nothing is read for a file that cannot be this frame's field.
+  if (!fs::is_regular_file(path, ec)) return {};
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec || size < kFieldHeaderBytes || size > max_field_file_bytes(want.width, want.height))
     return {};
+  std::string bytes(std::size_t(size), '\0');
   std::ifstream in(path, std::ios::binary);
-  FieldHeader want, have;
-  want.frame = frame, want.width = w, want.height = h, want.digest = digest;
-  if (!in.read(reinterpret_cast<char*>(&have), sizeof have) ||
-      std::memcmp(&have, &want, sizeof have) != 0)
+  // One byte more than the size said: a file that grew meanwhile is not this field.
+  if (!in.read(bytes.data(), std::streamsize(size)) ||
+      in.peek() != std::ifstream::traits_type::eof())
     return {};
-  Image<int32_t> nnf(w, h, 2);
-  for (int y = 0; y < h; ++y)
-    if (!in.read(reinterpret_cast<char*>(nnf.row(y)), std::streamsize(row_bytes))) return {};
-  return nnf;
+  return decode_field(bytes.data(), bytes.size(), want);
 }
 
 bool FileStore::has_frame(int frame) const {

@@ -76,11 +76,12 @@ class FileStore : public pipeline::Store {
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
-  // Only the field of a layer's last finished frame is kept: write_layer(frame) removes that of
-  // frame - 1 (so a run of frames a-b after a finished a - 1 runs frame a from the whole pyramid
-  // unless a - 1 was the last one finished). The field file is read as hostile input: anything but
-  // the exact header (magic, version, frame, the shot's size, the digest) and size gives an empty
-  // field, never a crash; the synthesizer draws any entry outside the exemplar at random.
+  // Every finished frame's field is kept (compressed, io/field_file.h, about a tenth of the
+  // uncompressed 8 bytes a pixel), so a run of frames a-b inside a finished shot starts frame a
+  // from frame a - 1's field exactly as the uninterrupted run did. The field file is read as
+  // hostile input: anything but the exact header (magic, version, frame, the shot's size, the
+  // digest) and a stream of exactly the shot's size gives an empty field (the frame then runs the
+  // whole pyramid), never a crash; the synthesizer draws any entry outside the exemplar at random.
   void write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
                    uint64_t digest) override;
   Image<int32_t> read_field(const pipeline::Layer& layer, int frame,

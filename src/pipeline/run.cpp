@@ -306,11 +306,29 @@ class ShotRun {
       now[i].nnf = std::move(r.nnf);
       if (!now[i].nnf.empty())
         store_.write_field(l, f, now[i].nnf.cview(), value_digest(now[i].value.cview()));
+      note_stale_chain(l, f, now[i].value.cview());
       store_.write_layer(l, f, now[i].value.cview());
       ++report_.synthesized;
       changed = true;
     }
     return changed;
+  }
+
+  // Before a forced run's last frame f of a temporal layer replaces the finished one: when the
+  // next frame is finished too and the new value differs from the old, the finished frames after
+  // f were made from the old one (RunReport::stale). An unreadable old frame counts as different.
+  void note_stale_chain(const Layer& l, int f, ImageView<const float> value) {
+    const int last = shot_.source.last_frame;
+    if (!o_.force || f != b_ || !l.temporal.enabled || f >= last || !store_.has_layer(l, f) ||
+        !store_.has_layer(l, f + 1))
+      return;
+    try {
+      if (value_digest(store_.read_layer(l, f).cview()) == value_digest(value)) return;
+    } catch (const Error&) {
+    }
+    int c = f + 1;
+    while (c < last && store_.has_layer(l, c + 1)) ++c;
+    report_.stale.push_back({l.name, f + 1, c});
   }
 
   // Composites frame f from every layer of the shot: this frame's new values, else the stored

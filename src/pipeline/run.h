@@ -76,6 +76,14 @@ struct RunReport {
   int reused = 0;                       // layer-frames read back (finished before)
   int composited = 0;                   // frames composited
   int first_frame = 0, last_frame = 0;  // frames visited (the chain may start before --frames)
+  // A temporal layer's finished frames after the run's last frame, made from that frame as it was
+  // before this (forced) run replaced it with a different one: `first`-`last` of `layer` no
+  // longer continue the chain.
+  struct Stale {
+    std::string layer;
+    int first = 0, last = 0;
+  };
+  std::vector<Stale> stale;
 };
 
 // The inputs of compositing that do not change from frame to frame.
