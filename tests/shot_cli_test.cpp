@@ -21,6 +21,7 @@
 
 #include "core/image.h"
 #include "io/field_file.h"
+#include "io/file_store.h"
 #include "io/image_io.h"
 #include "tests/small_painting.h"
 
@@ -54,13 +55,6 @@ bool same_pixels(const fs::path& a, const fs::path& b) {
     if (std::memcmp(x.row(r), y.row(r), sizeof(float) * x.width() * x.channels()) != 0)
       return false;
   return true;
-}
-
-// `pattern` with the layer name twice and the frame ("layers/%s/%s_%04d.exr").
-std::string fmt_name(const char* pattern, const std::string& layer, int frame) {
-  char name[128];
-  std::snprintf(name, sizeof name, pattern, layer.c_str(), layer.c_str(), frame);
-  return name;
 }
 
 int count_lines(const std::string& s) {
@@ -439,8 +433,10 @@ TEST_F(ShotCli, ForcedRangeInsideAFinishedShotIsBitIdentical) {
   RunResult r = emaki("run shot.toml");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   fs::copy(dir_ / "out", dir_ / "out_ref", fs::copy_options::recursive);
-  auto layer = [](const std::string& l, int f) { return fmt_name("layers/%s/%s_%04d.exr", l, f); };
-  auto field = [](const std::string& l, int f) { return fmt_name("layers/%s/.%s_%04d.nnf", l, f); };
+  // Names inside an output folder, as the store writes them.
+  const io::OutputPaths in_folder{"."};
+  auto layer = [&](const std::string& l, int f) { return in_folder.layer_exr(l, f); };
+  auto field = [&](const std::string& l, int f) { return in_folder.layer_field(l, f); };
   auto same = [&](const std::string& file) {
     return same_pixels(dir_ / "out" / file, dir_ / "out_ref" / file);
   };
