@@ -461,6 +461,13 @@ TEST_F(ShotCli, ForcedRangeInsideAFinishedShotIsBitIdentical) {
   EXPECT_EQ(r.err.find("warning", at + 1), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("warning: layer base: frames 5-6 were made from frame 4"), std::string::npos)
       << r.err;
+  // One stale frame is named as one frame, and the command given redoes just it.
+  std::ofstream(dir_ / "out" / field("base", 3), std::ios::trunc) << "damaged";
+  r = emaki("run shot.toml --force --frames 4-5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: layer base: frame 6 was made from frame 5 "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("--force --frames 6 --layers base` redoes it"), std::string::npos) << r.err;
 }
 
 TEST_F(ShotCli, KilledRunResumesToBitIdenticalFrames) {
