@@ -126,6 +126,19 @@ def args_of(p):
     return cmd
 
 
+def inputs_key(p):
+    """The pair's command line with each file named by its content's hash, so that a cached
+    run is reused whatever folder holds the same inputs (another worktree's examples/stylit)
+    and redone when a file's content changes."""
+    def digest(path):
+        with open(path, "rb") as f:
+            return "sha1:" + hashlib.sha1(f.read()).hexdigest()
+    parts = []
+    for arg in args_of(p):
+        parts.append(digest(arg) if os.path.isfile(arg) else arg)
+    return json.dumps(parts)
+
+
 def timed(cmd):
     """(wall seconds, CPU seconds user + system) of one run. The CPU time says what the run
     cost when the machine is shared and the wall time mostly measures the other jobs."""
@@ -138,7 +151,7 @@ def timed(cmd):
 
 
 def judge(a, p, out, pixels, cache):
-    key = hashlib.sha1(open(out, "rb").read() + json.dumps(args_of(p)).encode()).hexdigest()
+    key = hashlib.sha1(open(out, "rb").read() + inputs_key(p).encode()).hexdigest()
     if key not in cache:
         cmd = [a.judge] + args_of(p) + ["-output-to-judge", out]
         if pixels > 1_000_000:
@@ -198,7 +211,7 @@ def main():
         n = p["name"]
         e_out = os.path.join(a.out, f"{n}_{a.tag}.png")
         b_out = os.path.join(a.out, f"{n}_ebsynth.png")
-        key = json.dumps(args_of(p))
+        key = inputs_key(p)
         if (a.rerun_ebsynth or n not in eb or eb[n]["args"] != key or "cpu" not in eb[n] or
                 not os.path.exists(b_out)):
             secs, cpu = timed([a.ebsynth] + args_of(p) + ["-output", b_out])
