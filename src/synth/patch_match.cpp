@@ -401,14 +401,16 @@ Image<int32_t> identity_nnf(int tw, int th, int sw, int sh, int r) {
   return out;
 }
 
+void random_entry(int x, int y, int sw, int sh, int r, uint64_t seed, int32_t* out) {
+  CounterRng rng(hash_key(seed, 0x1417, uint64_t(y) * 65536u + uint64_t(x)));
+  out[0] = r + int(rng.uniform(uint32_t(sw - 2 * r)));
+  out[1] = r + int(rng.uniform(uint32_t(sh - 2 * r)));
+}
+
 Image<int32_t> random_nnf(int tw, int th, int sw, int sh, int r, uint64_t seed) {
   Image<int32_t> out(tw, th, 2);
   for (int y = 0; y < th; ++y)
-    for (int x = 0; x < tw; ++x) {
-      CounterRng rng(hash_key(seed, 0x1417, uint64_t(y) * 65536u + uint64_t(x)));
-      out(x, y, 0) = r + int(rng.uniform(uint32_t(sw - 2 * r)));
-      out(x, y, 1) = r + int(rng.uniform(uint32_t(sh - 2 * r)));
-    }
+    for (int x = 0; x < tw; ++x) random_entry(x, y, sw, sh, r, seed, out.at(x, y));
   return out;
 }
 

@@ -94,6 +94,8 @@ inline int64_t patch_distance(const PatchMatchLevel& L, const PatchMatchConfig& 
 Image<int32_t> upscale_nnf(const Image<int32_t>& coarse, int tw, int th, int sw, int sh, int r);
 Image<int32_t> identity_nnf(int tw, int th, int sw, int sh, int r);
 Image<int32_t> random_nnf(int tw, int th, int sw, int sh, int r, uint64_t seed);
+// random_nnf's entry at target pixel (x, y), written to out[0], out[1].
+void random_entry(int x, int y, int sw, int sh, int r, uint64_t seed, int32_t* out);
 
 // Patch error of every active target pixel against its current match, in EbSynth units.
 void compute_errors(const PatchMatchLevel& level, const PatchMatchConfig& config);

@@ -308,14 +308,17 @@ void write_style(const Image<float>& style, const FeatureLayout& L, Image<int16_
   pad_replicate(tgt, border, 0, ns);
 }
 
-// The warm start's field: `given` where its patch lies inside the source, a random draw
-// elsewhere.
+// The warm start's field: `given` where its patch lies inside the source, random_nnf's draw
+// elsewhere (drawn only there).
 Image<int32_t> warm_nnf(ImageView<const int32_t> given, int sw, int sh, int r, uint64_t seed) {
-  Image<int32_t> out = random_nnf(given.width, given.height, sw, sh, r, seed);
+  Image<int32_t> out(given.width, given.height, 2);
   for (int y = 0; y < given.height; ++y)
     for (int x = 0; x < given.width; ++x) {
       const int32_t sx = given(x, y, 0), sy = given(x, y, 1);
-      if (sx >= r && sx < sw - r && sy >= r && sy < sh - r) out(x, y, 0) = sx, out(x, y, 1) = sy;
+      if (sx >= r && sx < sw - r && sy >= r && sy < sh - r)
+        out(x, y, 0) = sx, out(x, y, 1) = sy;
+      else
+        random_entry(x, y, sw, sh, r, seed, out.at(x, y));
     }
   return out;
 }

@@ -1,5 +1,6 @@
 // Whole synthesis on small synthetic images: identity, schedule, determinism, masks, precision,
 // validation.
+#include "synth/patch_match.h"
 #include "synth/synthesizer.h"
 
 #include <gtest/gtest.h>
@@ -157,9 +158,13 @@ TEST(Synthesize, WarmStartFromAGivenField) {
   warm.initial_nnf = hostile.cview();
   again = synthesize(f.inputs(), warm, req);
   const int r = params.patch_size / 2;
+  // Entries whose patch leaves the source start at random_nnf's draw for that pixel.
+  const Image<int32_t> drawn = random_nnf(72, 40, 64, 48, r, warm.seed);
   for (int i = 0; i < 5; ++i) {
     const int x = again.nnf(7 * i, 3 * i, 0), y = again.nnf(7 * i, 3 * i, 1);
     EXPECT_TRUE(x >= r && x < 64 - r && y >= r && y < 48 - r) << i << ": " << x << ", " << y;
+    EXPECT_EQ(x, drawn(7 * i, 3 * i, 0)) << i;
+    EXPECT_EQ(y, drawn(7 * i, 3 * i, 1)) << i;
   }
 
   warm.finest_search_vote_iters = 1;
