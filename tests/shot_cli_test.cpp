@@ -470,6 +470,42 @@ TEST_F(ShotCli, ForcedRangeInsideAFinishedShotIsBitIdentical) {
   EXPECT_NE(r.err.find("--force --frames 6 --layers base` redoes it"), std::string::npos) << r.err;
 }
 
+// With temporal_fields = "last" a run keeps one warm-start field per temporal layer, the last
+// finished frame's, and a run that stopped part-way still resumes to the same frames as an
+// uninterrupted one.
+TEST_F(ShotCli, KeepingOnlyTheLastFieldStillResumesExactly) {
+  auto last_only = [&](const std::string& folder) {
+    std::string s = shot_text(5, "temporal_fields = \"last\"");
+    s.replace(s.find("[layers.outline]"), 16, "[layers.outline]\ntemporal_fields = \"last\"");
+    s.replace(s.find("folder = \"out\""), 14, "folder = \"" + folder + "\"");
+    return s;
+  };
+  write_shot(last_only("out_ref"), "ref.toml");
+  RunResult r = emaki("run ref.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  write_shot(last_only("out"));
+  r = emaki("run shot.toml --frames 0-2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(" 6 layer-frames synthesized, 6 already finished"), std::string::npos)
+      << r.err;
+  const io::OutputPaths in_folder{"."};
+  for (const char* l : {"base", "outline"})
+    for (int f = 0; f <= 5; ++f) {
+      const std::string exr = in_folder.layer_exr(l, f), field = in_folder.layer_field(l, f);
+      EXPECT_TRUE(same_pixels(dir_ / "out" / exr, dir_ / "out_ref" / exr)) << exr;
+      EXPECT_EQ(fs::exists(dir_ / "out" / field), f == 5) << field;
+      EXPECT_EQ(fs::exists(dir_ / "out_ref" / field), f == 5) << field;
+    }
+  // A forced range inside the finished shot has no field before it: its first frame runs the
+  // whole pyramid, and the run still succeeds.
+  r = emaki("run shot.toml --force --frames 3-4");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / in_folder.layer_field("base", 4)));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / in_folder.layer_field("base", 3)));
+}
+
 TEST_F(ShotCli, KilledRunResumesToBitIdenticalFrames) {
   const int last = 7;
   write_shot(shot_text(last));

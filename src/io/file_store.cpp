@@ -305,6 +305,14 @@ void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<c
   tmp.commit();
 }
 
+void FileStore::remove_field(const pipeline::Layer& layer, int frame) {
+  CHECK(access_ != StoreAccess::kInspect);
+  const std::string path = paths_.layer_field(layer.name, frame);
+  std::error_code ec;
+  // The store's own hidden file, and only a regular file: never a folder or a link's target.
+  if (fs::is_regular_file(fs::symlink_status(path, ec))) fs::remove(path, ec);
+}
+
 Image<int32_t> FileStore::read_field(const pipeline::Layer& layer, int frame,
                                      uint64_t digest) const {
   if (!layer_state(layer).current) return {};

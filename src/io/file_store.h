@@ -84,6 +84,7 @@ class FileStore : public pipeline::Store {
   // whole pyramid), never a crash; the synthesizer draws any entry outside the exemplar at random.
   void write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
                    uint64_t digest) override;
+  void remove_field(const pipeline::Layer& layer, int frame) override;
   Image<int32_t> read_field(const pipeline::Layer& layer, int frame,
                             uint64_t digest) const override;
   bool has_frame(int frame) const override;

@@ -47,6 +47,8 @@ class Store {
     (void)layer, (void)frame, (void)digest;
     return {};
   }
+  // Removes the layer's field at `frame`, if there is one (TemporalSpec::keep_every_field false).
+  virtual void remove_field(const Layer& layer, int frame) { (void)layer, (void)frame; }
   // True when every per-frame output (composite, layered EXR, ...) of `frame` exists.
   virtual bool has_frame(int frame) const = 0;
   // `composite` is RGBA; `layers` are in shot.layers order.

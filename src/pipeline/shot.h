@@ -126,6 +126,10 @@ struct TemporalSpec {
   // frame's field carried along the advection, instead of the whole pyramid from a random field
   // (docs/temporal.md). Off: every frame runs the whole pyramid, as before it existed.
   bool warm_start = true;
+  // Which warm-start fields a run keeps on disk: every finished frame's (a forced --frames range
+  // inside a finished shot then continues exactly), or the last finished frame's alone (a
+  // resumed run still does; a forced range starts its first frame from the whole pyramid).
+  bool keep_every_field = true;
 };
 
 struct SynthSpec {

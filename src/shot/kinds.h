@@ -47,6 +47,11 @@ inline constexpr Named<pipeline::AdvectionGuide> kAdvectionGuides[] = {
     {"position", pipeline::AdvectionGuide::kPosition},
     {"rest_position", pipeline::AdvectionGuide::kRestPosition},
 };
+// layers.NAME.temporal_fields: true keeps every frame's warm-start field, false the last one.
+inline constexpr Named<bool> kKeptFields[] = {
+    {"every", true},
+    {"last", false},
+};
 inline constexpr Named<composite::BlendMode> kBlendModes[] = {
     {"normal", composite::BlendMode::kNormal},
     {"multiply", composite::BlendMode::kMultiply},
