@@ -1,6 +1,5 @@
 // Whole synthesis on small synthetic images: identity, schedule, determinism, masks, precision,
 // validation.
-#include "synth/patch_match.h"
 #include "synth/synthesizer.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "synth/patch_match.h"
 #include "synth/test_images.h"
 
 namespace emaki::synth {
