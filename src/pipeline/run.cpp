@@ -308,8 +308,9 @@ class ShotRun {
         store_.write_field(l, f, now[i].nnf.cview(), value_digest(now[i].value.cview()));
       note_stale_chain(l, f, now[i].value.cview());
       store_.write_layer(l, f, now[i].value.cview());
-      // Frame f is finished: with only the last field kept, f - 1's is no longer needed.
-      if (!l.temporal.keep_every_field && !now[i].nnf.empty() && f > first_)
+      // Frame f is finished: with only the last field kept, f - 1's is no longer needed (also
+      // when f made none, its mask being empty: a resume from f then starts cold either way).
+      if (l.temporal.enabled && l.temporal.warm_start && !l.temporal.keep_every_field && f > first_)
         store_.remove_field(l, f - 1);
       ++report_.synthesized;
       changed = true;
