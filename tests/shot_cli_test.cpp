@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -542,13 +541,13 @@ TEST_F(ShotCli, KilledRunResumesToBitIdenticalFrames) {
   r = emaki("run shot.toml");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find(" 0 layer-frames synthesized"), std::string::npos) << r.err;
+  const io::OutputPaths in_folder{"."};  // names inside an output folder, as the store writes them
   for (int f = 0; f <= last; ++f) {
-    char name[64];
-    std::snprintf(name, sizeof name, "composite/frame_%04d.png", f);
-    EXPECT_TRUE(same_pixels(dir_ / "out" / name, dir_ / "out_ref" / name)) << name;
+    const std::string composite = in_folder.composite_png(f);
+    EXPECT_TRUE(same_pixels(dir_ / "out" / composite, dir_ / "out_ref" / composite)) << composite;
     for (const char* layer : {"base", "outline"}) {
-      std::snprintf(name, sizeof name, "layers/%s/%s_%04d.exr", layer, layer, f);
-      EXPECT_TRUE(same_pixels(dir_ / "out" / name, dir_ / "out_ref" / name)) << name;
+      const std::string exr = in_folder.layer_exr(layer, f);
+      EXPECT_TRUE(same_pixels(dir_ / "out" / exr, dir_ / "out_ref" / exr)) << exr;
     }
   }
   // No temporary file is left behind.
