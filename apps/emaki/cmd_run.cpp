@@ -82,15 +82,16 @@ int run_run(const Args& args) {
                r.report.composited, shot.outputs.folder.c_str());
   for (const std::string& p : r.previews) std::fprintf(stderr, "emaki run: wrote %s\n", p.c_str());
   for (const pipeline::RunReport::Stale& st : r.report.stale) {
+    const bool one = st.first == st.last;
     const std::string range =
-        st.first == st.last ? fmt::format("{}", st.first) : fmt::format("{}-{}", st.first, st.last);
+        one ? fmt::format("{}", st.first) : fmt::format("{}-{}", st.first, st.last);
     std::fprintf(stderr,
                  "emaki run: warning: layer %s: frame%s %s %s made from frame %d as it was before "
                  "this run changed it; `emaki run %s --force --frames %s --layers %s` redoes "
                  "%s\n",
-                 st.layer.c_str(), st.first == st.last ? "" : "s", range.c_str(),
-                 st.first == st.last ? "was" : "were", st.first - 1, c.shot_path.c_str(),
-                 range.c_str(), st.layer.c_str(), st.first == st.last ? "it" : "them");
+                 st.layer.c_str(), one ? "" : "s", range.c_str(), one ? "was" : "were",
+                 st.first - 1, c.shot_path.c_str(), range.c_str(), st.layer.c_str(),
+                 one ? "it" : "them");
   }
   return 0;
 }

@@ -214,7 +214,8 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   l.temporal.confidence = r.boolean("temporal_confidence", l.temporal.confidence);
   l.temporal.uniformity = r.real("temporal_uniformity", l.temporal.uniformity);
   l.temporal.warm_start = r.boolean("temporal_warm_start", l.temporal.warm_start);
-  l.temporal.keep_every_field = r.choice("temporal_fields", true, kKeptFields);
+  l.temporal.keep_every_field =
+      r.choice("temporal_fields", l.temporal.keep_every_field, kKeptFields);
   l.mask = d.mask;
   l.mask.kind = r.choice("mask", d.mask.kind, kMaskKinds);
   l.mask.dilate = r.real("mask_dilate", l.mask.dilate);
