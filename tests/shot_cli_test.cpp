@@ -498,11 +498,33 @@ TEST_F(ShotCli, KeepingOnlyTheLastFieldStillResumesExactly) {
       EXPECT_EQ(fs::exists(dir_ / "out_ref" / field), f == 5) << field;
     }
   // A forced range inside the finished shot has no field before it: its first frame runs the
-  // whole pyramid, and the run still succeeds.
+  // whole pyramid, and the run still succeeds. The field kept is still the last frame's.
   r = emaki("run shot.toml --force --frames 3-4");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(fs::exists(dir_ / "out" / in_folder.layer_field("base", 4)));
-  EXPECT_FALSE(fs::exists(dir_ / "out" / in_folder.layer_field("base", 3)));
+  for (int f = 0; f <= 5; ++f)
+    EXPECT_EQ(fs::exists(dir_ / "out" / in_folder.layer_field("base", f)), f == 5) << f;
+}
+
+// Switching a finished shot from temporal_fields = "every" to "last" drops the older fields at
+// the next run, also when it has no frame left to synthesize.
+TEST_F(ShotCli, SwitchingToTheLastFieldDropsTheOlderOnes) {
+  write_shot(shot_text(3));
+  RunResult r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::OutputPaths in_folder{"."};
+  for (int f = 0; f <= 3; ++f)
+    ASSERT_TRUE(fs::exists(dir_ / "out" / in_folder.layer_field("base", f)));
+  write_shot(shot_text(3, "temporal_fields = \"last\""));
+  r = emaki("run shot.toml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(" 0 layer-frames synthesized"), std::string::npos) << r.err;
+  for (int f = 0; f <= 3; ++f) {
+    EXPECT_EQ(fs::exists(dir_ / "out" / in_folder.layer_field("base", f)), f == 3) << f;
+    EXPECT_TRUE(fs::exists(dir_ / "out" / in_folder.layer_exr("base", f))) << f;
+  }
+  // The outline layer keeps every field.
+  for (int f = 0; f <= 3; ++f)
+    EXPECT_TRUE(fs::exists(dir_ / "out" / in_folder.layer_field("outline", f))) << f;
 }
 
 TEST_F(ShotCli, KilledRunResumesToBitIdenticalFrames) {

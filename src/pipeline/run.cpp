@@ -233,12 +233,27 @@ class ShotRun {
       if (passes_) prev_passes_ = {f, std::move(*passes_), {}};
       passes_.reset();
     }
+    drop_older_fields();
     return report_;
   }
 
  private:
   bool needs(const Layer& l, int f) const {
     return (o_.force && f >= a_) || !store_.has_layer(l, f);
+  }
+
+  // With temporal_fields = "last" a layer keeps one field: the last finished frame's, what a
+  // resumed run starts from. The loop above drops f - 1's as it goes; this also drops what a
+  // forced range, or an earlier run with "every", left behind.
+  void drop_older_fields() {
+    const int last = shot_.source.last_frame;
+    for (const Layer* l : selected_) {
+      if (!l->temporal.enabled || !l->temporal.warm_start || l->temporal.keep_every_field) continue;
+      int keep = last;
+      while (keep >= first_ && !store_.has_layer(*l, keep)) --keep;
+      for (int f = first_; f <= last; ++f)
+        if (f != keep) store_.remove_field(*l, f);
+    }
   }
 
   // The temporal chain continues from the last finished frame: start where the frame before
