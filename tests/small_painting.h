@@ -1,5 +1,6 @@
-// The small painting the shot tests use as a MatCap-like exemplar: a 100x76 box-filtered copy of
-// the StyLit painting, so exemplar pyramids stay tiny and tests stay fast.
+// Small paintings for the shot tests: box-filtered copies of a bundled painting (by default a
+// 100x76 copy of the StyLit painting, used as a MatCap-like exemplar), so exemplar pyramids and
+// the reference sphere's renders stay tiny and the tests stay fast, under the sanitizers too.
 #pragma once
 
 #include <string>
@@ -9,13 +10,15 @@
 
 namespace emaki::test {
 
-inline void write_small_painting(const std::string& stylit_png, const std::string& out) {
-  const Image<float> big = io::read_image_float(stylit_png);
-  const int w = 100, h = 76;
-  Image<float> small(w, h, 3);
+// Writes `png` box-filtered to w x h (every channel it has) as an 8-bit image at `out`.
+inline void write_small_painting(const std::string& png, const std::string& out, int w = 100,
+                                 int h = 76) {
+  const Image<float> big = io::read_image_float(png);
+  const int nc = big.channels();
+  Image<float> small(w, h, nc);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) {
+      for (int c = 0; c < nc; ++c) {
         const int x0 = x * big.width() / w, x1 = (x + 1) * big.width() / w;
         const int y0 = y * big.height() / h, y1 = (y + 1) * big.height() / h;
         double s = 0;

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "shot/shot.h"
+#include "tests/small_painting.h"
 
 namespace emaki::shot {
 namespace {
@@ -24,7 +25,9 @@ class PlanTest : public ::testing::Test {
             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
+    test::write_small_painting(kData + "/stylit/source_style.png", painting());
   }
+  std::string painting() const { return (dir_ / "painting.png").string(); }
   void TearDown() override { fs::remove_all(dir_); }
 
   // Frames [0, last]; `base` temporal, `ink` not.
@@ -32,7 +35,7 @@ class PlanTest : public ::testing::Test {
     const std::string text =
         "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nclip = \"Walk\"\nframes = [0, " +
         std::to_string(last) + "]\nsize = [32, 20]\naa = 1\n[exemplars.sphere]\npainting = \"" +
-        kData + "/stylit/source_style.png\"\n[layers.base]\nkind = \"base\"\n" +
+        painting() + "\"\n[layers.base]\nkind = \"base\"\n" +
         "exemplar = \"sphere\"\n[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\n" +
         "temporal = false\n[outputs]\nfolder = \"" + (dir_ / name).string() + "\"\nmp4 = false\n";
     const std::string path = (dir_ / (name + ".toml")).string();

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "io/image_io.h"
+#include "tests/small_painting.h"
 
 namespace emaki::shot {
 namespace {
@@ -24,20 +25,28 @@ class ShotApi : public ::testing::Test {
         ("emaki_shot_api_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
          "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(folder_);
+    inputs_ = folder_.string() + "_in";
+    fs::remove_all(inputs_);
+    fs::create_directories(inputs_);
+    test::write_small_painting(kData + "/stylit/source_style.png", pastel());
   }
-  void TearDown() override { fs::remove_all(folder_); }
+  void TearDown() override {
+    fs::remove_all(folder_);
+    fs::remove_all(inputs_);
+  }
+  std::string pastel() const { return (inputs_ / "pastel.png").string(); }
 
   pipeline::Shot tiny() const {
     const std::string text =
         "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nclip = \"Walk\"\n" +
-        "frames = [0, 2]\nsize = [40, 24]\naa = 1\n[exemplars.sphere]\npainting = \"" + kData +
-        "/stylit/source_style.png\"\n[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n" +
+        "frames = [0, 2]\nsize = [40, 24]\naa = 1\n[exemplars.sphere]\npainting = \"" + pastel() +
+        "\"\n[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n" +
         "[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\ntemporal = false\n" +
         "[outputs]\nfolder = \"" + folder_.string() + "\"\nmp4 = false\n";
     return open_text(text, (folder_.parent_path() / "tiny.toml").string());
   }
 
-  fs::path folder_;
+  fs::path folder_, inputs_;
 };
 
 TEST_F(ShotApi, RunResumesAndComposites) {
@@ -66,11 +75,15 @@ TEST_F(ShotApi, RunResumesAndComposites) {
 // Two styles mixed: the hatching layer's blend is a compositing setting, so changing only it
 // re-colours the finished layers (no synthesis, layer files untouched) and changes the mix.
 TEST_F(ShotApi, HatchingBlendChangesTheMixWithoutSynthesis) {
+  // The town's 800x600 hatching at a quarter of its size, its sphere with it.
+  const std::string hatching = (inputs_ / "hatching.png").string();
+  test::write_small_painting(std::string(EMAKI_SOURCE_DIR) + "/examples/town/hatching.png",
+                             hatching, 200, 150);
   auto text = [&](const std::string& blend) {
     return "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nclip = \"Walk\"\n" +
-           "frames = [0, 1]\nsize = [48, 32]\naa = 1\n[exemplars.pastel]\npainting = \"" + kData +
-           "/stylit/source_style.png\"\n[exemplars.hatching]\npainting = \"" + EMAKI_SOURCE_DIR +
-           "/examples/town/hatching.png\"\nsphere = [400, 300, 180]\n[layers.base]\n" +
+           "frames = [0, 1]\nsize = [48, 32]\naa = 1\n[exemplars.pastel]\npainting = \"" +
+           pastel() + "\"\n[exemplars.hatching]\npainting = \"" + hatching +
+           "\"\nsphere = [100, 75, 45]\n[layers.base]\n" +
            "kind = \"base\"\nexemplar = \"pastel\"\n[layers.hatching]\nexemplar = \"hatching\"\n" +
            "guides = { normal = 1, diffuse = 1 }\nmask = \"covered\"\nalpha = \"inverse_value\"\n" +
            "gradient = [[0, 0.2, 0.15, 0.3], [1, 1, 1, 1]]\nopacity = 0.8\nblend = \"" + blend +
