@@ -68,32 +68,42 @@ void vote_rows(ImageView<const T> source, const Image<int32_t>& nnf, const Image
     }
 }
 
-// The plain vote of integer samples, row by row from the patches' side: output row y sums, for
-// every active patch centred within r rows of it, that patch's source row — 2r + 1 contiguous
-// pixels added to contiguous accumulators, which vectorizes, where the per-pixel form gathers
-// (2r + 1)^2 scattered pixels. The sums are integers, so they equal the per-pixel form's exactly.
-template <int NC, int P, typename T>
-void vote_rows_plain_scatter(ImageView<const T> source, const Image<int32_t>& nnf,
-                             const Image<uint8_t>& active, Image<float>& out, int y0, int y1) {
+// The same vote, row by row from the patches' side: output row y sums, for every active patch
+// centred within r rows of it, that patch's source row — P contiguous pixels added to contiguous
+// accumulators, which vectorizes, where the per-pixel form gathers P^2 scattered pixels. Each
+// output pixel receives its patches in the per-pixel form's order (rows, then columns, upward),
+// so the double sums are the same to the bit; plain integer sums are exact either way.
+template <int NC, int P, typename T, bool Plain>
+void vote_rows_scatter(ImageView<const T> source, const Image<int32_t>& nnf,
+                       const Image<float>& weight, const Image<uint8_t>& active, Image<float>& out,
+                       int y0, int y1) {
   constexpr int r = P / 2;
   const int tw = nnf.width(), th = nnf.height();
   const bool all = active.empty();
   constexpr double scale = sample_scale<T>();
-  std::vector<int32_t> acc(std::size_t(tw + 2 * r) * NC), count(std::size_t(tw + 2 * r));
+  // int32 for plain integer samples: at most P^2 <= 25 samples of 16 bits per pixel.
+  using Acc = std::conditional_t<Plain && std::is_integral_v<T>, int32_t, double>;
+  // Offset by r pixels so that patches at the image's edges add whole rows; the columns outside
+  // the image are dropped.
+  std::vector<Acc> acc(std::size_t(tw + 2 * r) * NC), wsum(std::size_t(tw + 2 * r));
   for (int y = y0; y < y1; ++y) {
-    std::fill(acc.begin(), acc.end(), 0);
-    std::fill(count.begin(), count.end(), 0);
-    // Accumulators are offset by r pixels so that patches at the image's edges add whole rows;
-    // the columns outside the image are dropped.
+    std::fill(acc.begin(), acc.end(), Acc(0));
+    std::fill(wsum.begin(), wsum.end(), Acc(0));
     for (int uy = std::max(0, y - r); uy <= std::min(th - 1, y + r); ++uy) {
       const int32_t* m = nnf.row(uy);
       for (int ux = 0; ux < tw; ++ux, m += 2) {
         if (!all && !active(ux, uy)) continue;
         const T* s = source.row(m[1] + (y - uy)) + std::ptrdiff_t(m[0] - r) * NC;
-        int32_t* a = acc.data() + std::size_t(ux) * NC;  // column ux - r, offset by r
-        for (int k = 0; k < P * NC; ++k) a[k] += int32_t(s[k]);
-        int32_t* c = count.data() + ux;
-        for (int k = 0; k < P; ++k) c[k] += 1;
+        Acc* a = acc.data() + std::size_t(ux) * NC;  // column ux - r
+        Acc* ws = wsum.data() + ux;
+        if constexpr (Plain) {
+          for (int k = 0; k < P * NC; ++k) a[k] += Acc(s[k]);
+          for (int k = 0; k < P; ++k) ws[k] += Acc(1);
+        } else {
+          const double w = weight(ux, uy);
+          for (int k = 0; k < P * NC; ++k) a[k] += w * double(s[k]);
+          for (int k = 0; k < P; ++k) ws[k] += w;
+        }
       }
     }
     for (int x = 0; x < tw; ++x) {
@@ -102,9 +112,9 @@ void vote_rows_plain_scatter(ImageView<const T> source, const Image<int32_t>& nn
         for (int c = 0; c < NC; ++c) o[c] = 0.0f;
         continue;
       }
-      // The pixel's own patch always counts: count > 0.
-      const double inv = scale / double(count[std::size_t(x) + r]);
-      const int32_t* a = acc.data() + (std::size_t(x) + r) * NC;
+      // The pixel's own patch always counts: wsum > 0.
+      const double inv = scale / double(wsum[std::size_t(x) + r]);
+      const Acc* a = acc.data() + (std::size_t(x) + r) * NC;
       for (int c = 0; c < NC; ++c) o[c] = float(double(a[c]) * inv);
     }
   }
@@ -113,12 +123,12 @@ void vote_rows_plain_scatter(ImageView<const T> source, const Image<int32_t>& nn
 template <int NC, typename T>
 void vote_rows(ImageView<const T> source, const Image<int32_t>& nnf, const Image<float>& weight,
                const Image<uint8_t>& active, int r, Image<float>& out, int y0, int y1, bool plain) {
-  if constexpr (std::is_integral_v<T> && sizeof(T) <= 2) {
-    // int32 sums: at most 25 samples of 16 bits per pixel and channel.
-    if (plain && r == 2 && source.channels == NC)
-      return vote_rows_plain_scatter<NC, 5>(source, nnf, active, out, y0, y1);
-    if (plain && r == 1 && source.channels == NC)
-      return vote_rows_plain_scatter<NC, 3>(source, nnf, active, out, y0, y1);
+  if (source.channels == NC && (r == 1 || r == 2)) {  // 3x3 and 5x5 patches, packed pixels
+    if (r == 2)
+      return plain ? vote_rows_scatter<NC, 5, T, true>(source, nnf, weight, active, out, y0, y1)
+                   : vote_rows_scatter<NC, 5, T, false>(source, nnf, weight, active, out, y0, y1);
+    return plain ? vote_rows_scatter<NC, 3, T, true>(source, nnf, weight, active, out, y0, y1)
+                 : vote_rows_scatter<NC, 3, T, false>(source, nnf, weight, active, out, y0, y1);
   }
   if (plain)
     vote_rows<NC, T, true>(source, nnf, weight, active, r, out, y0, y1);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "core/rng.h"
@@ -57,11 +58,33 @@ TEST(Voting, WeightedFavoursLowErrorPatches) {
   EXPECT_GT(weighted(2, 2), 0.9f);
 }
 
-// The plain vote of integer samples sums row-wise from the patches' side; the weighted vote at
-// zero error (every weight 1) still gathers per pixel in doubles. Both must give the same floats,
-// at the image's edges, with a target mask, for 1-4 channels and every patch size.
+// The vote of 3x3 and 5x5 patches sums row-wise from the patches' side. Against the per-pixel
+// definition (each pixel's patches in row, then column order, double sums), every float must be
+// the same: plain votes of integer and float samples, and the weighted vote at zero error (every
+// weight 1), at the image's edges, with and without a target mask, 1-4 channels.
 template <typename T>
-void expect_plain_equals_unit_weighted(int max_value) {
+Image<float> per_pixel_vote(const Image<T>& src, const Image<int32_t>& nnf,
+                            const Image<uint8_t>& active, int p, double scale) {
+  const int tw = nnf.width(), th = nnf.height(), nc = src.channels(), r = p / 2;
+  Image<float> out(tw, th, nc);
+  for (int y = 0; y < th; ++y)
+    for (int x = 0; x < tw; ++x) {
+      if (!active.empty() && !active(x, y)) continue;
+      double acc[4] = {}, wsum = 0.0;
+      for (int uy = std::max(0, y - r); uy <= std::min(th - 1, y + r); ++uy)
+        for (int ux = std::max(0, x - r); ux <= std::min(tw - 1, x + r); ++ux) {
+          if (!active.empty() && !active(ux, uy)) continue;
+          const T* s = src.at(nnf(ux, uy, 0) - (ux - x), nnf(ux, uy, 1) - (uy - y));
+          for (int c = 0; c < nc; ++c) acc[c] += double(s[c]);
+          wsum += 1.0;
+        }
+      for (int c = 0; c < nc; ++c) out(x, y, c) = float(acc[c] * (scale / wsum));
+    }
+  return out;
+}
+
+template <typename T>
+void expect_votes_equal_per_pixel_vote(double max_value, double scale) {
   CounterRng rng(5);
   const int sw = 23, sh = 19, tw = 17, th = 13;
   for (int nc = 1; nc <= 4; ++nc)
@@ -69,7 +92,9 @@ void expect_plain_equals_unit_weighted(int max_value) {
       const int r = p / 2;
       Image<T> src(sw, sh, nc);
       for (int y = 0; y < sh; ++y)
-        for (int x = 0; x < sw * nc; ++x) src.row(y)[x] = T(rng.uniform(uint32_t(max_value + 1)));
+        for (int x = 0; x < sw * nc; ++x)
+          src.row(y)[x] = T(std::is_integral_v<T> ? double(rng.uniform(uint32_t(max_value) + 1))
+                                                  : rng.uniform_float() * max_value);
       Image<int32_t> nnf(tw, th, 2);
       Image<uint8_t> active(tw, th, 1);
       for (int y = 0; y < th; ++y)
@@ -78,26 +103,28 @@ void expect_plain_equals_unit_weighted(int max_value) {
           nnf(x, y, 1) = r + int(rng.uniform(uint32_t(sh - 2 * r)));
           active(x, y) = rng.uniform(4) != 0 ? 1 : 0;
         }
-      Image<float> err(tw, th, 1), plain, weighted;
-      for (const Image<uint8_t>* mask : {static_cast<const Image<uint8_t>*>(&active),
-                                         static_cast<const Image<uint8_t>*>(nullptr)}) {
-        const Image<uint8_t> none;
-        const Image<uint8_t>& a = mask ? *mask : none;
-        vote(Plane(src.cview()), nnf, err, a, p, VoteMode::kPlain, plain);
-        vote(Plane(src.cview()), nnf, err, a, p, VoteMode::kWeighted, weighted);
-        for (int y = 0; y < th; ++y)
-          for (int x = 0; x < tw; ++x)
-            for (int c = 0; c < nc; ++c)
-              ASSERT_EQ(plain(x, y, c), weighted(x, y, c))
-                  << "channels " << nc << " patch " << p << " at " << x << "," << y
-                  << (mask ? " masked" : "");
+      const Image<uint8_t> none;
+      Image<float> err(tw, th, 1), out;
+      for (const Image<uint8_t>* a : {&none, static_cast<const Image<uint8_t>*>(&active)}) {
+        const Image<float> want = per_pixel_vote(src, nnf, *a, p, scale);
+        for (VoteMode mode : {VoteMode::kPlain, VoteMode::kWeighted}) {
+          vote(Plane(src.cview()), nnf, err, *a, p, mode, out);
+          for (int y = 0; y < th; ++y)
+            for (int x = 0; x < tw; ++x)
+              for (int c = 0; c < nc; ++c)
+                ASSERT_EQ(out(x, y, c), want(x, y, c))
+                    << "channels " << nc << " patch " << p << " at " << x << "," << y
+                    << (a == &none ? "" : " masked")
+                    << (mode == VoteMode::kPlain ? " plain" : " weighted");
+        }
       }
     }
 }
 
-TEST(Voting, PlainIntegerVoteEqualsUnitWeightedVote) {
-  expect_plain_equals_unit_weighted<uint8_t>(255);
-  expect_plain_equals_unit_weighted<uint16_t>(65535);
+TEST(Voting, EqualsThePerPixelVote) {
+  expect_votes_equal_per_pixel_vote<uint8_t>(255.0, 1.0 / 255.0);
+  expect_votes_equal_per_pixel_vote<uint16_t>(65535.0, 1.0 / 65535.0);
+  expect_votes_equal_per_pixel_vote<float>(1.0, 1.0);
 }
 
 }  // namespace
