@@ -22,21 +22,23 @@ inline int64_t hsum64(__m256i v) {
 
 namespace {
 
-// The kernel for rows of E elements, E known at compile time (the common patch widths times
-// channel counts): the row loop unrolls and the widening schedule folds away. Same sums, same
-// stops as the general loop below.
+// Rows of row_elems elements: 16 per vector, then an 8-element tail. With E > 0 the width is
+// known at compile time (E == row_elems): the row loop unrolls and the widening schedule folds
+// away. Each int32 lane takes at most three squared-pair sums before it is widened to int64.
 template <int E>
-int64_t ssd_fixed(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
-                  std::ptrdiff_t b_stride, int rows, int64_t bound) {
-  static_assert(E % 8 == 0 && E > 0);
-  constexpr int kFull = E / 16;
+[[gnu::always_inline]] inline int64_t ssd_rows(const int16_t* a, std::ptrdiff_t a_stride,
+                                               const int16_t* b, std::ptrdiff_t b_stride,
+                                               int row_elems, int rows, int64_t bound) {
+  static_assert(E % 8 == 0 && E >= 0);
+  const int n = E > 0 ? E : row_elems;
+  const int full = n / 16;
   __m256i acc64 = _mm256_setzero_si256();
   for (int j = 0; j < rows; ++j) {
     const int16_t* pa = a + j * a_stride;
     const int16_t* pb = b + j * b_stride;
     __m256i acc32 = _mm256_setzero_si256();
 #pragma GCC unroll 8
-    for (int v = 0; v < kFull; ++v) {
+    for (int v = 0; v < full; ++v) {
       const __m256i va = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pa + 16 * v));
       const __m256i vb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pb + 16 * v));
       const __m256i d = _mm256_sub_epi16(va, vb);
@@ -46,51 +48,11 @@ int64_t ssd_fixed(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
         acc32 = _mm256_setzero_si256();
       }
     }
-    if constexpr (E % 16 != 0) {  // an 8-element tail
-      const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pa + 16 * kFull));
-      const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + 16 * kFull));
+    if (n % 16 != 0) {  // an 8-element tail: the lane then holds at most full % 3 + 1 <= 3 sums
+      const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pa + 16 * full));
+      const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + 16 * full));
       const __m128i d = _mm_sub_epi16(va, vb);
       acc32 = _mm256_add_epi32(acc32, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
-    }
-    acc64 = widen_add(acc64, acc32);
-    if (j + 1 < rows) {
-      const int64_t s = hsum64(acc64);
-      if (s > bound) return s;
-    }
-  }
-  return hsum64(acc64);
-}
-
-int64_t ssd_general(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,
-                    std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound) {
-  __m256i acc64 = _mm256_setzero_si256();
-  for (int j = 0; j < rows; ++j) {
-    const int16_t* pa = a + j * a_stride;
-    const int16_t* pb = b + j * b_stride;
-    __m256i acc32 = _mm256_setzero_si256();
-    int pending = 0;
-    int i = 0;
-    for (; i + 16 <= row_elems; i += 16) {
-      const __m256i va = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pa + i));
-      const __m256i vb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pb + i));
-      const __m256i d = _mm256_sub_epi16(va, vb);
-      acc32 = _mm256_add_epi32(acc32, _mm256_madd_epi16(d, d));
-      if (++pending == 3) {
-        acc64 = widen_add(acc64, acc32);
-        acc32 = _mm256_setzero_si256();
-        pending = 0;
-      }
-    }
-    if (i < row_elems) {  // an 8-element tail
-      const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pa + i));
-      const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + i));
-      const __m128i d = _mm_sub_epi16(va, vb);
-      const __m256i sq = _mm256_zextsi128_si256(_mm_madd_epi16(d, d));
-      if (pending == 3) {
-        acc64 = widen_add(acc64, acc32);
-        acc32 = _mm256_setzero_si256();
-      }
-      acc32 = _mm256_add_epi32(acc32, sq);
     }
     acc64 = widen_add(acc64, acc32);
     if (j + 1 < rows) {
@@ -107,17 +69,17 @@ int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t*
                        std::ptrdiff_t b_stride, int row_elems, int rows, int64_t bound) {
   switch (row_elems) {
     case 24:  // 3x3 patches of 8 channels (the 3x3 pass)
-      return ssd_fixed<24>(a, a_stride, b, b_stride, rows, bound);
+      return ssd_rows<24>(a, a_stride, b, b_stride, row_elems, rows, bound);
     case 40:  // 5x5 patches of 8 channels
-      return ssd_fixed<40>(a, a_stride, b, b_stride, rows, bound);
+      return ssd_rows<40>(a, a_stride, b, b_stride, row_elems, rows, bound);
     case 48:
-      return ssd_fixed<48>(a, a_stride, b, b_stride, rows, bound);
+      return ssd_rows<48>(a, a_stride, b, b_stride, row_elems, rows, bound);
     case 80:  // 5x5 patches of 16 channels (StyLit's four RGB guides)
-      return ssd_fixed<80>(a, a_stride, b, b_stride, rows, bound);
+      return ssd_rows<80>(a, a_stride, b, b_stride, row_elems, rows, bound);
     case 120:
-      return ssd_fixed<120>(a, a_stride, b, b_stride, rows, bound);
+      return ssd_rows<120>(a, a_stride, b, b_stride, row_elems, rows, bound);
     default:
-      return ssd_general(a, a_stride, b, b_stride, row_elems, rows, bound);
+      return ssd_rows<0>(a, a_stride, b, b_stride, row_elems, rows, bound);
   }
 }
 

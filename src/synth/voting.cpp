@@ -22,16 +22,13 @@ constexpr double sample_scale() {
     return 1.0;
 }
 
-// Plain: every patch weighs 1, so integer samples are summed exactly in integers (the same sums
-// the double accumulation gives, at a fraction of the cost: the finest level's plain votes read
-// the 8-bit input).
+// The per-pixel vote (patches other than 3x3 and 5x5); Plain: every patch weighs 1.
 template <int NC, typename T, bool Plain>
 void vote_rows(ImageView<const T> source, const Image<int32_t>& nnf, const Image<float>& weight,
                const Image<uint8_t>& active, int r, Image<float>& out, int y0, int y1) {
   const int tw = nnf.width(), th = nnf.height();
   const bool all = active.empty();
   constexpr double scale = sample_scale<T>();
-  using Acc = std::conditional_t<Plain && std::is_integral_v<T>, int64_t, double>;
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < tw; ++x) {
       float* o = out.at(x, y);
@@ -39,32 +36,26 @@ void vote_rows(ImageView<const T> source, const Image<int32_t>& nnf, const Image
         for (int c = 0; c < NC; ++c) o[c] = 0.0f;
         continue;
       }
-      // Exact sums (integers, or doubles): where every patch agrees the vote returns exactly the
-      // source value, so an exact match stays exact after re-quantisation.
-      Acc acc[NC] = {};
-      Acc wsum = 0;
+      // Double sums: where every patch agrees the vote returns exactly the source value, so an
+      // exact match stays exact after re-quantisation.
+      double acc[NC] = {};
+      double wsum = 0.0;
       const int uy0 = std::max(0, y - r), uy1 = std::min(th - 1, y + r);
       const int ux0 = std::max(0, x - r), ux1 = std::min(tw - 1, x + r);
       for (int uy = uy0; uy <= uy1; ++uy) {
         const int32_t* m = nnf.at(ux0, uy);
-        const float* wrow = nullptr;
-        if constexpr (!Plain) wrow = weight.row(uy);
+        const float* wrow = Plain ? nullptr : weight.row(uy);
         for (int ux = ux0; ux <= ux1; ++ux, m += 2) {
           if (!all && !active(ux, uy)) continue;
           const T* s = source.at(m[0] - (ux - x), m[1] - (uy - y));
-          if constexpr (Plain) {
-            for (int c = 0; c < NC; ++c) acc[c] += Acc(s[c]);
-            wsum += 1;
-          } else {
-            const double w = wrow[ux];
-            for (int c = 0; c < NC; ++c) acc[c] += w * double(s[c]);
-            wsum += w;
-          }
+          const double w = Plain ? 1.0 : double(wrow[ux]);
+          for (int c = 0; c < NC; ++c) acc[c] += w * double(s[c]);
+          wsum += w;
         }
       }
       // The pixel's own patch always counts: wsum > 0.
-      const double inv = scale / double(wsum);
-      for (int c = 0; c < NC; ++c) o[c] = float(double(acc[c]) * inv);
+      const double inv = scale / wsum;
+      for (int c = 0; c < NC; ++c) o[c] = float(acc[c] * inv);
     }
 }
 
