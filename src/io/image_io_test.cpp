@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "io/read_limits.h"
 
 namespace fs = std::filesystem;
@@ -69,6 +70,49 @@ TEST_F(ImageIo, Png16BitRoundTripIsExact) {
       for (int k = 0; k < 3; ++k)
         ASSERT_EQ(std::get<Image<uint16_t>>(back.image)(x, y, k),
                   std::lround(im(x, y, k) * 65535.0f));
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+// PNG is written in strips of rows deflated in parallel (png_write.cpp). Images of many strips,
+// every channel count and both depths must read back exactly (through libpng), and the file must
+// be byte for byte the same for any thread count.
+TEST_F(ImageIo, PngInManyStripsRoundTripsAndIgnoresThreadCount) {
+  for (const bool sixteen : {false, true})
+    for (int c = 1; c <= 4; ++c) {
+      SCOPED_TRACE(std::to_string(c) + (sixteen ? " channels, 16-bit" : " channels, 8-bit"));
+      // 300 wide: 301-2401 bytes a row, so 1300 rows make 2-12 strips of 2^18 bytes.
+      Image<float> im = ramp(300, 1300, c, sixteen ? 65536 : 256);
+      for (int x = 0; x < 300; x += 3) im(x, 700, 0) = -1.0f;  // clamped to 0
+      for (int x = 1; x < 300; x += 3) im(x, 701, 0) = 2.0f;   // clamped to 1
+      WriteOptions o;
+      o.format = sixteen ? SampleFormat::kU16 : SampleFormat::kU8;
+      std::string first;
+      for (int threads : {1, 2, 3}) {
+        set_thread_count(threads);
+        write_image(p("s.png"), im.cview(), o);
+        const std::string bytes = file_bytes(p("s.png"));
+        if (first.empty()) first = bytes;
+        EXPECT_EQ(bytes, first) << threads << " threads";
+      }
+      set_thread_count(0);
+      const AnyImage back = read_image(p("s.png"));
+      ASSERT_EQ(back.channels(), c);
+      ASSERT_EQ(back.width(), 300);
+      ASSERT_EQ(back.height(), 1300);
+      for (int y = 0; y < 1300; ++y)
+        for (int x = 0; x < 300; ++x)
+          for (int k = 0; k < c; ++k) {
+            const float v = std::clamp(im(x, y, k), 0.0f, 1.0f);
+            if (sixteen)
+              ASSERT_EQ(std::get<Image<uint16_t>>(back.image)(x, y, k), std::lround(v * 65535.0f));
+            else
+              ASSERT_EQ(std::get<Image<uint8_t>>(back.image)(x, y, k), std::lround(v * 255.0f));
+          }
+    }
 }
 
 TEST_F(ImageIo, FloatExrRoundTripIsExactWithNamedChannels) {
