@@ -1,4 +1,5 @@
-// PNG through libpng directly: the format most guides and exemplars come in. Kept apart from
+// PNG read through libpng directly (png_io.cpp) and written by emaki with zlib, in parallel strips
+// (png_write.cpp): the format most guides and exemplars come in. Kept apart from
 // OpenImageIO because Debian's OpenImageIO pulls in ~120 MB of libraries (OpenVDB, GDAL, ...)
 // at load time, more than the whole synthesis of a 1200x912 frame needs; OpenImageIO is loaded
 // only when another format is read or written (see image_io.cpp).
