@@ -115,6 +115,20 @@ TEST_F(ImageIo, PngInManyStripsRoundTripsAndIgnoresThreadCount) {
     }
 }
 
+// Wider than libpng (and so emaki's reader) accepts: refused by name, nothing left behind.
+TEST_F(ImageIo, PngWiderThanLibpngReadsIsRefused) {
+  const Image<float> im(1000001, 1, 1);
+  try {
+    write_image(p("wide.png"), im.cview());
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.subject(), p("wide.png"));
+    EXPECT_NE(std::string(e.what()).find("limited to 1000000 pixels"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(fs::is_empty(dir_));
+}
+
 TEST_F(ImageIo, FloatExrRoundTripIsExactWithNamedChannels) {
   Image<float> im(19, 11, 3);
   for (int y = 0; y < 11; ++y)

@@ -8,6 +8,7 @@
 // so a strip loses nothing by not seeing the one before it. Measured with `emaki synth` (wall
 // time outside reading and synthesis, two threads; docs/eval.md): 2048^2 0.74-0.77 s -> 0.08 s,
 // StyLit 1200x912 0.13-0.16 s -> 0.03-0.05 s; the files are 2 % smaller to 4 % larger.
+#include <pnglibconf.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -35,6 +37,9 @@ struct FileCloser {
 // Raw bytes per strip (about): enough rows that deflate's per-strip start costs little, few
 // enough that a 1080p frame makes dozens of strips for the threads to share.
 constexpr std::size_t kStripBytes = std::size_t(1) << 18;
+
+constexpr int kMaxSide = PNG_USER_WIDTH_MAX;
+static_assert(PNG_USER_WIDTH_MAX == PNG_USER_HEIGHT_MAX && PNG_USER_WIDTH_MAX <= 1000000);
 
 void put_u32(std::vector<unsigned char>& out, uint32_t v) {
   for (int s = 24; s >= 0; s -= 8) out.push_back((unsigned char)(v >> s));
@@ -162,6 +167,10 @@ void write_png(std::FILE* opened, ImageView<const float> image, bool sixteen_bit
   std::unique_ptr<FILE, FileCloser> file(opened);
   if (image.channels < 1 || image.channels > 4) throw Error(subject, "PNG takes 1 to 4 channels");
   if (image.width < 1 || image.height < 1) throw Error(subject, "PNG needs at least one pixel");
+  // libpng's own limit, which emaki's reader keeps: a wider or taller file could not be read
+  // back. It also bounds a strip (8 MB a row at most) well below zlib's and PNG's 32-bit sizes.
+  if (image.width > kMaxSide || image.height > kMaxSide)
+    throw Error(subject, "PNG sides are limited to " + std::to_string(kMaxSide) + " pixels");
   const int w = image.width, h = image.height;
   const std::size_t row = std::size_t(w) * image.channels * (sixteen_bit ? 2 : 1) + 1;
   const int strip_rows = int(std::max<std::size_t>(1, kStripBytes / row));
