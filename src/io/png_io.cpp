@@ -118,12 +118,6 @@ struct DecoderCloser {
   ~DecoderCloser() { png_destroy_read_struct(&d.png, &d.info, nullptr); }
 };
 
-struct FileCloser {
-  void operator()(FILE* f) const {
-    if (f) std::fclose(f);
-  }
-};
-
 // Walks the chunk layout (length, type, data, CRC) up to IEND before libpng sees the bytes.
 // libpng allocates a chunk's claimed length before reading it (a 10-byte tEXt that claims
 // 1.9 GB took 1.9 GB), and a truncated file would be found short only after its whole image

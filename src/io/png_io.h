@@ -13,6 +13,13 @@
 
 namespace emaki::io::detail {
 
+// Closes a FILE held by a unique_ptr (the reader's and the writer's files).
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f) std::fclose(f);
+  }
+};
+
 // 8/16-bit gray, gray+alpha, RGB, RGBA (palette and low bit depths are expanded to 8-bit).
 // The size in the header is checked against the pixel budget (core/limits.h) before any pixel
 // memory is allocated. Errors throw emaki::Error naming `path` (or `name`).

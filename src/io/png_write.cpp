@@ -28,12 +28,6 @@
 namespace emaki::io::detail {
 namespace {
 
-struct FileCloser {
-  void operator()(FILE* f) const {
-    if (f) std::fclose(f);
-  }
-};
-
 // Raw bytes per strip (about): enough rows that deflate's per-strip start costs little, few
 // enough that a 1080p frame makes dozens of strips for the threads to share.
 constexpr std::size_t kStripBytes = std::size_t(1) << 18;
@@ -70,30 +64,29 @@ int paeth(int a, int b, int c) {
 // and out[1..n]: of the five filters, the one whose bytes, read as signed, have the smallest
 // sum of magnitudes (the heuristic the PNG specification recommends, and libpng's default).
 void filter_row(const unsigned char* prev, const unsigned char* cur, int n, int bpp,
-                std::array<std::vector<unsigned char>, 5>& scratch, unsigned char* out) {
-  unsigned char* none = scratch[0].data();
-  unsigned char* sub = scratch[1].data();
-  unsigned char* up = scratch[2].data();
-  unsigned char* avg = scratch[3].data();
-  unsigned char* pae = scratch[4].data();
+                std::array<std::vector<unsigned char>, 4>& scratch, unsigned char* out) {
+  unsigned char* sub = scratch[0].data();
+  unsigned char* up = scratch[1].data();
+  unsigned char* avg = scratch[2].data();
+  unsigned char* pae = scratch[3].data();
   for (int i = 0; i < n; ++i) {
     const int a = i >= bpp ? cur[i - bpp] : 0, b = prev[i], c = i >= bpp ? prev[i - bpp] : 0;
-    none[i] = cur[i];
     sub[i] = (unsigned char)(cur[i] - a);
     up[i] = (unsigned char)(cur[i] - b);
     avg[i] = (unsigned char)(cur[i] - (a + b) / 2);
     pae[i] = (unsigned char)(cur[i] - paeth(a, b, c));
   }
+  // Filter type f's bytes: the row itself for 0 (none), else scratch[f - 1].
+  const unsigned char* filtered[5] = {cur, sub, up, avg, pae};
   long best_sum = -1;
   int best = 0;
   for (int f = 0; f < 5; ++f) {
-    const unsigned char* d = scratch[f].data();
     long sum = 0;
-    for (int i = 0; i < n; ++i) sum += d[i] < 128 ? d[i] : 256 - d[i];
+    for (int i = 0; i < n; ++i) sum += filtered[f][i] < 128 ? filtered[f][i] : 256 - filtered[f][i];
     if (best_sum < 0 || sum < best_sum) best_sum = sum, best = f;
   }
   out[0] = (unsigned char)best;
-  std::copy(scratch[best].begin(), scratch[best].begin() + n, out + 1);
+  std::copy(filtered[best], filtered[best] + n, out + 1);
 }
 
 // One strip: rows [y0, y1) filtered and deflated. `last` ends the deflate stream.
@@ -109,7 +102,7 @@ Strip encode_strip(ImageView<const float> image, bool sixteen_bit, int y0, int y
   const int bpp = image.channels * (sixteen_bit ? 2 : 1);
   std::vector<unsigned char> prev(n, 0), cur(n);
   if (y0 > 0) row_bytes(image, y0 - 1, sixteen_bit, prev.data());
-  std::array<std::vector<unsigned char>, 5> scratch;
+  std::array<std::vector<unsigned char>, 4> scratch;
   for (auto& s : scratch) s.resize(n);
   Strip s;
   s.raw_size = std::size_t(y1 - y0) * (n + 1);
