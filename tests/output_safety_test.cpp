@@ -246,6 +246,28 @@ TEST_F(OutputSafety, PreviewsReplaceALinkAtTheirNameAndLeaveNoTemporary) {
     EXPECT_EQ(e.path().filename().string().find(".emaki-tmp-"), std::string::npos) << e.path();
 }
 
+// emaki starts itself again with glibc's huge-page tunable where the kernel's THP mode is
+// "madvise" (apps/emaki/huge_pages.h); what it runs inherits that environment, so a stand-in
+// ffmpeg early on PATH shows whether the restart happened.
+TEST_F(OutputSafety, RunsWithHugePagesWhereTheKernelTakesAdvice) {
+  if (std::getenv("GLIBC_TUNABLES")) GTEST_SKIP() << "GLIBC_TUNABLES set by the caller";
+  const std::string mode = slurp("/sys/kernel/mm/transparent_hugepage/enabled");
+  ShotText t;
+  t.last = 0;
+  t.mp4 = true;
+  write_shot(t);
+  fs::create_directories(dir_ / "bin");
+  write_text(dir_ / "bin/ffmpeg",
+             "#!/bin/sh\nprintf '%s' \"$GLIBC_TUNABLES\" > '" + p("tunables") + "'\n");
+  fs::permissions(dir_ / "bin/ffmpeg", fs::perms::owner_all);
+  test::CliOptions o;
+  o.cwd = dir_;
+  o.env = {"PATH=" + p("bin") + ":" + std::getenv("PATH")};
+  expect_ok(test::run_cli(EMAKI_BINARY, {"run", p("shot.toml")}, o));
+  const bool advised = mode.find("[madvise]") != std::string::npos;
+  EXPECT_EQ(slurp(dir_ / "tunables"), advised ? "glibc.malloc.hugetlb=1" : "") << mode;
+}
+
 // ---- the output-folder lock ----
 
 TEST_F(OutputSafety, SecondRunOnTheSameFolderNamesTheHolder) {

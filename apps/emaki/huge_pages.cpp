@@ -1,0 +1,35 @@
+#include "apps/emaki/huge_pages.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+
+namespace emaki::app {
+
+std::optional<std::string> huge_page_tunables(const char* tunables, const char* preload,
+                                              const std::string& thp_mode) {
+  if (thp_mode.find("[madvise]") == std::string::npos) return std::nullopt;
+  if (preload && std::string(preload).find("vgpreload") != std::string::npos) return std::nullopt;
+  const std::string current = tunables ? tunables : "";
+  if (current.find("glibc.malloc.hugetlb") != std::string::npos) return std::nullopt;
+  return current.empty() ? "glibc.malloc.hugetlb=1" : current + ":glibc.malloc.hugetlb=1";
+}
+
+void restart_with_huge_pages(char** argv) {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  const std::string mode((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const char* before = std::getenv("GLIBC_TUNABLES");
+  const std::optional<std::string> tunables = huge_page_tunables(before, std::getenv("LD_PRELOAD"), mode);
+  if (!tunables) return;
+  const std::string kept = before ? before : "";
+  if (::setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
+  ::execv("/proc/self/exe", argv);  // returns only on failure: go on as we were
+  if (before)
+    ::setenv("GLIBC_TUNABLES", kept.c_str(), 1);
+  else
+    ::unsetenv("GLIBC_TUNABLES");
+}
+
+}  // namespace emaki::app

@@ -1,0 +1,29 @@
+// Transparent huge pages for emaki's own process: glibc maps every large image anew and the
+// kernel faults it in 4 KB at a time. On a kernel whose THP mode is "madvise", glibc's tunable
+// glibc.malloc.hugetlb=1 has malloc advise huge pages on what it maps: 2 MB per fault instead of
+// 4 KB (a 6-frame `emaki run` of the example: 0.56 M page faults -> 0.03 M, wall -20 to -35 %;
+// docs/eval.md, "Huge pages"). Tunables are read only when a program starts, so `emaki` starts
+// itself again once with the tunable added. Outputs do not change: only where memory comes from.
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace emaki::app {
+
+// The GLIBC_TUNABLES value to start again with, or nullopt to go on as we are: when the kernel's
+// THP mode (the text of /sys/kernel/mm/transparent_hugepage/enabled, "always [madvise] never")
+// is not "madvise" (with "always" every large mapping gets huge pages already; with "never" none
+// can), or when `tunables` (the current GLIBC_TUNABLES, may be null) already names
+// glibc.malloc.hugetlb (the user's choice, =0 turns this off; also what ends the one restart),
+// or when `preload` (LD_PRELOAD, may be null) shows Valgrind, whose launcher a restart through
+// /proc/self/exe would run instead of emaki.
+std::optional<std::string> huge_page_tunables(const char* tunables, const char* preload,
+                                              const std::string& thp_mode);
+
+// Starts this program again (same arguments, same pid) with the tunable added when
+// huge_page_tunables says so; returns when it does not, or when the restart fails (nothing
+// changes then). Call first thing in main, before any thread is started.
+void restart_with_huge_pages(char** argv);
+
+}  // namespace emaki::app
