@@ -21,7 +21,8 @@ void restart_with_huge_pages(char** argv) {
   std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
   const std::string mode((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const char* before = std::getenv("GLIBC_TUNABLES");
-  const std::optional<std::string> tunables = huge_page_tunables(before, std::getenv("LD_PRELOAD"), mode);
+  const std::optional<std::string> tunables =
+      huge_page_tunables(before, std::getenv("LD_PRELOAD"), mode);
   if (!tunables) return;
   const std::string kept = before ? before : "";
   if (::setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;

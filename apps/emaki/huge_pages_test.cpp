@@ -22,16 +22,16 @@ TEST(HugePages, KeepsTheUsersTunablesAndTheirChoice) {
             "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1");
   // Named already: the user's choice (=0 turns huge pages off), or our own restart.
   EXPECT_EQ(huge_page_tunables("glibc.malloc.hugetlb=0", nullptr, kMadvise), std::nullopt);
-  EXPECT_EQ(huge_page_tunables("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1", nullptr,
-                               kMadvise),
-            std::nullopt);
+  EXPECT_EQ(
+      huge_page_tunables("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1", nullptr, kMadvise),
+      std::nullopt);
 }
 
 TEST(HugePages, NeverUnderValgrind) {
   // Valgrind preloads its core; /proc/self/exe is then its launcher, which refuses to run.
-  EXPECT_EQ(huge_page_tunables(nullptr, "/usr/libexec/valgrind/vgpreload_core-amd64-linux.so",
-                               kMadvise),
-            std::nullopt);
+  EXPECT_EQ(
+      huge_page_tunables(nullptr, "/usr/libexec/valgrind/vgpreload_core-amd64-linux.so", kMadvise),
+      std::nullopt);
   EXPECT_EQ(huge_page_tunables(nullptr, "/usr/lib/libsomething.so", kMadvise),
             "glibc.malloc.hugetlb=1");
 }

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -9,6 +10,7 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/parallel.h"
 #include "io/field_file.h"
 #include "io/image_io.h"
 #include "io/shot_manifest.h"
@@ -370,14 +372,18 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
     }
     for (const char* c : {"composite.R", "composite.G", "composite.B"}) names.push_back(c);
     Image<float> all(passes.width, passes.height, channels);
-    for (int y = 0; y < passes.height; ++y)
-      for (int x = 0; x < passes.width; ++x) {
-        float* d = all.at(x, y);
-        for (int c = 0; c < passes.channels; ++c) *d++ = passes(x, y, c);
-        for (const auto& l : layers)
-          for (int c = 0; c < l.channels; ++c) *d++ = l(x, y, c);
-        for (int c = 0; c < 3; ++c) *d++ = rgb(x, y, c);
+    parallel_rows(passes.height, 16, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y) {
+        float* d = all.row(y);
+        const float* p = passes.row(y);
+        const float* c = rgb.row(y);
+        for (int x = 0; x < passes.width; ++x) {
+          d = std::copy_n(p + std::ptrdiff_t(x) * passes.channels, passes.channels, d);
+          for (const auto& l : layers) d = std::copy_n(l.at(x, y), l.channels, d);
+          d = std::copy_n(c + 3 * x, 3, d);
+        }
       }
+    });
     WriteOptions wo;
     wo.format = SampleFormat::kHalf;
     wo.channel_names = names;
