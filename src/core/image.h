@@ -5,6 +5,8 @@
 // are explicit (clone()).
 #pragma once
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -20,6 +22,23 @@
 namespace emaki {
 
 inline constexpr std::size_t kRowAlign = 64;
+
+namespace detail {
+// Images of this size or more ask the kernel for transparent huge pages before their first
+// touch: where its mode is "madvise" a large image is then faulted in 2 MB at a time instead of
+// 4 KB (the Python module's only way to them: `emaki` itself also restarts with glibc's tunable,
+// apps/emaki/huge_pages.h). Pixels do not change, only how their memory is mapped.
+// Inline, so that every library holding images (also the dlopen'ed OpenImageIO module) has it.
+inline constexpr std::size_t kHugePageAdviceBytes = std::size_t(4) << 20;
+inline void advise_huge_pages(void* p, std::size_t bytes) {
+  if (bytes < kHugePageAdviceBytes) return;
+  constexpr std::uintptr_t kPage = 4096;  // the advice covers whole pages inside the block
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) / kPage * kPage;
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(p) + bytes) / kPage * kPage;
+  // Advice only: a kernel without transparent huge pages refuses it, and nothing changes then.
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+}  // namespace detail
 
 template <typename T>
 struct ImageView {
@@ -69,6 +88,7 @@ class Image {
     T* mem = static_cast<T*>(std::aligned_alloc(kRowAlign, bytes));
     if (mem == nullptr) throw std::bad_alloc();
     mem_.reset(mem);
+    detail::advise_huge_pages(mem, bytes);
     width_ = width;
     height_ = height;
     channels_ = channels;
