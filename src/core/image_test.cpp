@@ -2,13 +2,13 @@
 #include "core/image.h"
 
 #include <gtest/gtest.h>
+#include <sys/mman.h>
 
 #include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string>
-#include <vector>
 
 namespace emaki {
 namespace {
@@ -45,15 +45,26 @@ TEST(Image, LargeImagesAskForHugePagesWhereTheKernelTakesAdvice) {
   EXPECT_EQ(large(100, 700, 3), 0.0f);  // still zero-filled
 }
 
-TEST(Image, AdviceOnABlockWithoutAWholePageDoesNothing) {
-  // Below the threshold nothing is advised; inside a block of the threshold's size that starts
-  // off a page boundary, only the whole pages are (no error either way: it is advice).
-  float small[16] = {};
-  detail::advise_huge_pages(small, sizeof(small));
-  std::vector<char> block(detail::kHugePageAdviceBytes + 1);
-  detail::advise_huge_pages(block.data() + 1, detail::kHugePageAdviceBytes);
-  EXPECT_EQ(small[3], 0.0f);
-  EXPECT_EQ(block[7], 0);
+TEST(Image, AdviceOnlyFromTheThresholdAndOnlyOnWholePages) {
+  if (slurp("/sys/kernel/mm/transparent_hugepage/enabled").find("[madvise]") == std::string::npos)
+    GTEST_SKIP() << "the kernel's THP mode is not madvise";
+  // Two mappings of their own, so that no other advice in the process shows in their flags.
+  const std::size_t n = 2 * detail::kHugePageAdviceBytes;
+  char* below = static_cast<char*>(
+      ::mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
+  char* from = static_cast<char*>(
+      ::mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
+  ASSERT_NE(below, MAP_FAILED);
+  ASSERT_NE(from, MAP_FAILED);
+  detail::advise_huge_pages(below, detail::kHugePageAdviceBytes - 1);
+  EXPECT_EQ(vm_flags_at(below).find(" hg"), std::string::npos) << vm_flags_at(below);
+  // A block off a page boundary: its first partial page keeps its flags, the whole pages after
+  // it are advised.
+  detail::advise_huge_pages(from + 1, detail::kHugePageAdviceBytes);
+  EXPECT_EQ(vm_flags_at(from).find(" hg"), std::string::npos) << vm_flags_at(from);
+  EXPECT_NE(vm_flags_at(from + 4096).find(" hg"), std::string::npos) << vm_flags_at(from + 4096);
+  ::munmap(below, n);
+  ::munmap(from, n);
 }
 
 }  // namespace
