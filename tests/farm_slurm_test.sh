@@ -90,6 +90,10 @@ for s in a b; do
   sed "s|folder = \"$work/$s\"|folder = \"$work/ref_$s\"|" "$work/$s.toml" >"$work/ref_$s.toml"
   "$emaki" run "$work/ref_$s.toml" --threads 1 2>/dev/null || fail "emaki run ref_$s"
 done
+# b's output folder holds a space, a Slurm pattern (%j) and shell syntax: it stays out of the
+# #SBATCH lines and is one quoted word in the script, so none of it is expanded or run.
+b_out="$work/b 50%j \$(touch $work/pwned)"
+sed -i "s|folder = \"$work/b\"|folder = \"$b_out\"|" "$work/b.toml"
 t0=$SECONDS
 "$emaki" farm submit "$work/a.toml" "$work/b.toml" --chunk 3 || fail "submit a b"
 wait_queue 300
@@ -98,7 +102,9 @@ status=$("$emaki" farm status "$work/a.toml" "$work/b.toml" --chunk 3)
 echo "$status" | tail -n 1
 echo "$status" | grep -vE ' done |^[0-9]+ done$' && fail "a task of a or b is not done"
 same_outputs "$work/ref_a" "$work/a"
-same_outputs "$work/ref_b" "$work/b"
+same_outputs "$work/ref_b" "$b_out"
+[ -e "$work/pwned" ] && fail "a command in b's folder name ran"
+ls "$b_out/farm/logs/"slurm-*_*.log >/dev/null 2>&1 || fail "no Slurm log in b's farm/logs"
 # Submitting a finished shot again submits nothing.
 again=$("$emaki" farm submit "$work/a.toml" --chunk 3 2>&1)
 echo "$again" | grep -q "0 tasks in 0 job arrays submitted" || fail "resubmitting a finished shot: $again"
@@ -111,7 +117,7 @@ sed "s|folder = \"$work/c\"|folder = \"$work/ref_c\"|" "$work/c.toml" >"$work/re
 running=""
 end=$((SECONDS + 120))
 while [ -z "$running" ] && [ $SECONDS -lt $end ]; do
-  running=$("$emaki" farm status "$work/c.toml" --chunk 4 | awk '$1 == "c.layer.base.0-11" && $2 == "running" { print $3 }')
+  running=$("$emaki" farm status "$work/c.toml" --chunk 4 | awk '$1 ~ /^c-[0-9a-f]+\.layer\.base\.0-11$/ && $2 == "running" { print $3 }')
   [ -z "$running" ] && sleep 0.1
 done
 [ -n "$running" ] || fail "c.layer.base.0-11 never ran"
@@ -120,8 +126,8 @@ scancel "$running"
 echo "cancelled c.layer.base.0-11 (job $running) while it ran"
 wait_queue 120
 status=$("$emaki" farm status "$work/c.toml" --chunk 4)
-echo "$status" | grep -qE "^c.layer.base.0-11 +failed +.*stopped while running" || fail "the cancelled task is not reported stopped while running"
-echo "$status" | grep '^c.composite' | grep -q 'done' && fail "compositing ran after a cancelled layer"
+echo "$status" | grep -qE "^c-[0-9a-f]+\.layer\.base\.0-11 +failed +.*stopped while running" || fail "the cancelled task is not reported stopped while running"
+echo "$status" | grep -E '^c-[0-9a-f]+\.composite' | grep -q 'done' && fail "compositing ran after a cancelled layer"
 echo "$status" | tail -n 1
 leftovers=$(find "$work/c" -name '.*.emaki-tmp-*' | wc -l)
 echo "temporaries the cancelled task left: $leftovers"
@@ -147,10 +153,10 @@ sed -i 's|^start = .*|start = 0.5|' "$work/d.toml" "$work/ref_d.toml"
 "$emaki" farm submit "$work/bad.toml" "$work/d.toml" --chunk 3 || fail "submit bad d"
 wait_queue 300
 status=$("$emaki" farm status "$work/bad.toml" "$work/d.toml" --chunk 3)
-echo "$status" | grep '^bad\.'
-echo "$status" | grep -E '^bad\.prepare +failed .*bad.prepare.log: .*error' >/dev/null ||
+echo "$status" | grep -E '^bad-[0-9a-f]+\.'
+echo "$status" | grep -E '^bad-[0-9a-f]+\.prepare +failed .*bad-[0-9a-f]+\.prepare\.log: .*error' >/dev/null ||
   fail "status does not name bad.prepare as failed with its error line"
-echo "$status" | grep -E '^bad\.composite' | grep -vq 'not run' && fail "bad's compositing ran"
-echo "$status" | grep -E '^d\.' | grep -v ' done ' && fail "shot d did not complete beside bad"
+echo "$status" | grep -E '^bad-[0-9a-f]+\.composite' | grep -vq 'not run' && fail "bad's compositing ran"
+echo "$status" | grep -E '^d-[0-9a-f]+\.' | grep -v ' done ' && fail "shot d did not complete beside bad"
 same_outputs "$work/ref_d" "$work/d"
 [ "$failures" -eq 0 ] && echo "PASS"

@@ -131,7 +131,26 @@ void parse_size(const std::string& option, const std::string& text, int& width, 
   check_pixel_budget(option, width, height);
 }
 
-bool parse_cli(CLI::App& app, const Args& args) {
+namespace {
+
+// A shot file whose name starts with '-' ("-x.toml") would read as an option: an argument that
+// ends in ".toml" and is no option of the command is taken as a file ("./-x.toml"), so it needs
+// no "--" before it.
+Args shot_files_as_paths(const CLI::App& app, Args args) {
+  for (std::string& a : args) {
+    if (a == "--") break;
+    if (a.size() < 2 || a[0] != '-' || !a.ends_with(".toml")) continue;
+    const std::string name =
+        a[1] == '-' ? a.substr(0, a.find('=')) : a.substr(0, 2);  // "--opt=v" / "-xVALUE"
+    if (!app.get_option_no_throw(name)) a = "./" + a;
+  }
+  return args;
+}
+
+}  // namespace
+
+bool parse_cli(CLI::App& app, const Args& in) {
+  const Args args = shot_files_as_paths(app, in);
   std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them reversed
   try {
     app.parse(reversed);

@@ -1,18 +1,24 @@
 #include "farm/slurm.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
-#include <charconv>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
+#include <tuple>
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/utf8.h"
+#include "farm/farm_state.h"
 #include "farm/process.h"
+#include "farm/script_text.h"
 #include "io/file_store.h"
 #include "io/output_store.h"
 
@@ -20,6 +26,7 @@ namespace emaki::farm {
 
 namespace fs = std::filesystem;
 using shot::Plan;
+using shot::PlannedShot;
 using shot::Task;
 
 const char* task_state_name(TaskState s) {
@@ -46,12 +53,6 @@ std::string farm_folder(const Plan& plan, int shot) {
   return plan.shots[std::size_t(shot)].shot.outputs.folder + "/farm";
 }
 
-std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // What a failed command said: its first line of stderr.
 std::string first_line(const std::string& text) {
   return echo(text.substr(0, text.find('\n')), 300);
@@ -59,24 +60,47 @@ std::string first_line(const std::string& text) {
 
 // farm/jobs.tsv: "TASK \t JOBID \t INDEX" per submitted task; a later line wins.
 std::map<std::string, std::string> read_jobs(const std::string& folder) {
-  std::map<std::string, std::string> jobs;
-  std::ifstream in(folder + "/jobs.tsv");
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ss(line);
-    std::string task, job, index;
-    if (std::getline(ss, task, '\t') && std::getline(ss, job, '\t') && std::getline(ss, index))
-      jobs[task] = job + "_" + index;
-  }
-  return jobs;
+  const std::string path = folder + "/jobs.tsv";
+  const std::optional<std::string> text = read_state_file(path, kMaxJobsFileBytes);
+  return text ? parse_jobs(*text, path) : std::map<std::string, std::string>{};
 }
 
+// Appends the records with one write, then fsync and close, each checked: a record that did not
+// reach the disk is an error before another job is queued.
 void append_jobs(const std::string& folder, const std::vector<const Task*>& tasks,
                  const std::string& job) {
-  std::ofstream out(folder + "/jobs.tsv", std::ios::app);
-  for (std::size_t i = 0; i < tasks.size(); ++i)
-    out << tasks[i]->id << '\t' << job << '\t' << i << '\n';
-  if (!out) throw Error(folder + "/jobs.tsv", "cannot record the submitted jobs");
+  const std::string path = folder + "/jobs.tsv";
+  std::string text;
+  for (std::size_t i = 0; i < tasks.size(); ++i) text += job_record(tasks[i]->id, job, i);
+  const auto failed = [&](const char* what) {
+    return Error(path,
+                 fmt::format("cannot record job {} ({}: {})", job, what, std::strerror(errno)));
+  };
+  const int fd = ::open(path.c_str(),
+                        O_WRONLY | O_APPEND | O_CREAT | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644);
+  if (fd < 0) throw failed("open");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    errno = EINVAL;
+    throw failed("not a regular file");
+  }
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;
+      ::close(fd);
+      throw failed("write");
+    }
+    done += std::size_t(n);
+  }
+  if (::fsync(fd) != 0) {
+    ::close(fd);
+    throw failed("fsync");
+  }
+  if (::close(fd) != 0) throw failed("close");
 }
 
 // farm/chunk: the chunk of the last submission, one decimal number.
@@ -91,42 +115,80 @@ void record_chunk(const std::string& folder, int chunk) {
 
 std::optional<int> read_chunk(const std::string& folder) {
   const std::string path = folder + "/chunk";
-  std::ifstream in(path);
-  if (!in) return std::nullopt;
-  char buf[32] = {};
-  in.read(buf, sizeof buf - 1);
-  std::string text(buf, std::size_t(in.gcount()));
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
-  int chunk = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), chunk);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || chunk < 1 ||
-      chunk > kMaxFrameCount)
-    throw Error(path, fmt::format("is not a chunk of frames in [1, {}]: '{}'; submit the shot "
-                                  "again or pass --chunk",
-                                  kMaxFrameCount, echo(text, 40)));
-  return chunk;
+  const std::optional<std::string> text = read_state_file(path, kMaxSmallFileBytes);
+  if (!text) return std::nullopt;
+  return parse_chunk(*text, path);
 }
 
-// The queue: "JOBID_INDEX" -> (state, reason), every array element on its own line.
-std::map<std::string, std::pair<std::string, std::string>> queue() {
-  const ProcessResult r = run_process({"squeue", "-h", "-r", "-o", "%i|%T|%r"});
+// The submitting user: squeue and scancel see no one else's jobs.
+std::string user_id() {
+  return std::to_string(::getuid());
+}
+
+// The queue: "JOBID_INDEX" -> (state, reason, job name), every array element on its own line.
+std::map<std::string, QueuedJob> queue() {
+  const ProcessResult r = run_process({"squeue", "-h", "-r", "-u", user_id(), "-o", "%i|%T|%r|%j"});
   if (r.exit_code != 0)
     throw Error("squeue", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
-  std::map<std::string, std::pair<std::string, std::string>> q;
-  std::istringstream ss(r.out);
-  std::string line;
-  while (std::getline(ss, line)) {
-    const std::size_t a = line.find('|'), b = line.find('|', a + 1);
-    if (a == std::string::npos || b == std::string::npos) continue;
-    std::string id = line.substr(0, a);
-    if (id.find('_') == std::string::npos) id += "_0";
-    q[id] = {line.substr(a + 1, b - a - 1), line.substr(b + 1)};
-  }
-  return q;
+  return parse_queue(r.out);
 }
 
 std::string job_of(const std::string& element) {
   return element.substr(0, element.find('_'));
+}
+
+// The job name of a shot's array of one task kind: a job in the queue is the shot's own only
+// when it carries one of these names (a copied or stale jobs.tsv names other jobs).
+std::string job_name(const Plan& plan, int shot, shot::TaskKind kind) {
+  return fmt::format("emaki:{}:{}", job_name_part(plan.shots[std::size_t(shot)].name),
+                     shot::task_kind_name(kind));
+}
+
+bool shot_owns(const Plan& plan, int shot, const std::string& name) {
+  for (shot::TaskKind kind :
+       {shot::TaskKind::kPrepare, shot::TaskKind::kPasses, shot::TaskKind::kLayer,
+        shot::TaskKind::kComposite, shot::TaskKind::kPreviews})
+    if (name == job_name(plan, shot, kind)) return true;
+  return false;
+}
+
+// The shot's recorded jobs that are in the queue under one of its own names: job id -> name.
+std::map<std::string, std::string> queued_jobs(const Plan& plan, int shot,
+                                               const std::map<std::string, QueuedJob>& q) {
+  std::map<std::string, std::string> out;
+  for (const auto& [task, element] : read_jobs(farm_folder(plan, shot)))
+    if (const auto it = q.find(element); it != q.end() && shot_owns(plan, shot, it->second.name))
+      out[job_of(element)] = it->second.name;
+  return out;
+}
+
+// The #SBATCH lines of an array of tasks. Only values that pass directive_value reach them; the
+// farm folder does not (sbatch runs with --chdir=FARM and --output is relative to it).
+std::string directives(const Plan& plan, const std::vector<const Task*>& tasks,
+                       const std::vector<std::string>& depends, const SlurmOptions& o) {
+  const Task& first = *tasks.front();
+  int64_t memory = 0;
+  int threads = 1;
+  for (const Task* t : tasks) memory = std::max(memory, t->memory_mb), threads = t->threads;
+  std::string s =
+      fmt::format("#SBATCH --job-name={}\n",
+                  directive_value(job_name(plan, first.shot, first.kind), "job name", "._-:"));
+  s += fmt::format("#SBATCH --array=0-{}\n", tasks.size() - 1);
+  s += "#SBATCH --output=logs/slurm-%A_%a.log\n";
+  s += fmt::format("#SBATCH --cpus-per-task={}\n#SBATCH --mem={}M\n", threads, memory);
+  using Option = std::tuple<const char*, const std::string*, const char*>;
+  for (const auto& [name, value, allowed] :
+       {Option{"partition", &o.partition, "._-,"}, Option{"account", &o.account, "._-"},
+        Option{"time", &o.time, ":-"}})
+    if (!value->empty())
+      s += fmt::format("#SBATCH --{}={}\n", name,
+                       directive_value(*value, fmt::format("--{}", name), allowed));
+  if (!depends.empty()) {
+    std::string ids;
+    for (const std::string& d : depends) ids += ":" + directive_value(d, "dependency", "{}._-:");
+    s += "#SBATCH --dependency=afterok" + ids + "\n#SBATCH --kill-on-invalid-dep=yes\n";
+  }
+  return s;
 }
 
 }  // namespace
@@ -134,40 +196,36 @@ std::string job_of(const std::string& element) {
 std::string batch_script(const Plan& plan, const std::vector<const Task*>& tasks,
                          const std::vector<std::string>& depends, const SlurmOptions& o) {
   const Task& first = *tasks.front();
+  const PlannedShot& shot = plan.shots[std::size_t(first.shot)];
   const std::string farm = farm_folder(plan, first.shot);
-  int64_t memory = 0;
-  int threads = 1;
-  for (const Task* t : tasks) memory = std::max(memory, t->memory_mb), threads = t->threads;
-  std::string s = "#!/bin/sh\n";
-  s += fmt::format("#SBATCH --job-name=emaki:{}:{}\n", plan.shots[std::size_t(first.shot)].name,
-                   shot::task_kind_name(first.kind));
-  s += fmt::format("#SBATCH --array=0-{}\n", tasks.size() - 1);
-  s += fmt::format("#SBATCH --output={}/logs/slurm-%A_%a.log\n", farm);
-  s += fmt::format("#SBATCH --cpus-per-task={}\n#SBATCH --mem={}M\n", threads, memory);
-  if (!o.partition.empty()) s += "#SBATCH --partition=" + o.partition + "\n";
-  if (!o.account.empty()) s += "#SBATCH --account=" + o.account + "\n";
-  if (!o.time.empty()) s += "#SBATCH --time=" + o.time + "\n";
-  if (!depends.empty()) {
-    std::string ids;
-    for (const std::string& d : depends) ids += ":" + d;
-    s += "#SBATCH --dependency=afterok" + ids + "\n#SBATCH --kill-on-invalid-dep=yes\n";
-  }
-  s += "# Written by `emaki farm submit`: one case per task of the array.\n";
+  // Errors name the shot file; one whose path is not UTF-8 is named with '?' for its bad bytes.
+  const std::string subject = echo_path(valid_utf8_or_marks(shot.path));
+  const std::string farm_word = shell_word(farm, fmt::format("{}: outputs.folder", subject));
+  std::string s = "#!/bin/sh\n" + directives(plan, tasks, depends, o);
+  s += "# Written by `emaki farm submit`, which runs it as `sbatch --chdir=FARM`: --output is\n";
+  s += "# relative to FARM. One case per task of the array.\n";
   s += "case \"$SLURM_ARRAY_TASK_ID\" in\n";
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     std::string argv;
-    for (const std::string& a : tasks[i]->argv) argv += fmt::format(" {}", quoted(a));
-    s += fmt::format("  {}) TASK={}; set --{} ;;\n", i, quoted(tasks[i]->id), argv);
+    for (const std::string& a : tasks[i]->argv)
+      argv += " " + shell_word(a, fmt::format("{}: task {}", subject,
+                                              echo(valid_utf8_or_marks(tasks[i]->id))));
+    s += fmt::format("  {}) TASK={}; set --{} ;;\n", i, shell_word(tasks[i]->id, subject), argv);
   }
   s += "  *) echo \"emaki farm: no task $SLURM_ARRAY_TASK_ID in this array\" >&2; exit 2 ;;\n";
   s += "esac\n";
-  s += "FARM=" + quoted(farm) + "\n";
+  s += "FARM=" + farm_word + "\n";
+  // Each record is made afresh: rm takes away whatever is at its path (a symlink planted there
+  // included) and noclobber creates the file exclusively, so nothing is written through a link.
+  s += "put() { rm -f \"$2\" && (set -C; printf '%s\\n' \"$1\" >\"$2\"); }\n";
   s += "rm -f \"$FARM/status/$TASK.exit\"\n";
-  s += "date +%s.%N >\"$FARM/status/$TASK.start\"\n";
-  s += "\"$@\" >\"$FARM/logs/$TASK.log\" 2>&1\n";
+  s += "put \"$(date +%s.%N)\" \"$FARM/status/$TASK.start\"\n";
+  s += "rm -f \"$FARM/logs/$TASK.log\"\n";
+  s += "(set -C; exec \"$@\" >\"$FARM/logs/$TASK.log\" 2>&1)\n";
   s += "rc=$?\n";
-  s += "date +%s.%N >\"$FARM/status/$TASK.end\"\n";
-  s += "echo \"$rc\" >\"$FARM/status/$TASK.exit.tmp\" && mv \"$FARM/status/$TASK.exit.tmp\" "
+  s += "put \"$(date +%s.%N)\" \"$FARM/status/$TASK.end\"\n";
+  // mv -T renames over the path itself: a symlink there is replaced, not followed.
+  s += "put \"$rc\" \"$FARM/status/$TASK.exit.tmp\" && mv -f -T \"$FARM/status/$TASK.exit.tmp\" "
        "\"$FARM/status/$TASK.exit\"\n";
   s += "exit \"$rc\"\n";
   return s;
@@ -177,28 +235,60 @@ namespace {
 
 // The queued jobs of a shot from earlier submissions: submitting over them would run a task
 // twice at once.
-void check_nothing_queued(const Plan& plan, int shot,
-                          const std::map<std::string, std::pair<std::string, std::string>>& q) {
-  std::set<std::string> queued;
-  for (const auto& [task, element] : read_jobs(farm_folder(plan, shot)))
-    if (q.count(element)) queued.insert(job_of(element));
+void check_nothing_queued(const Plan& plan, int shot, const std::map<std::string, QueuedJob>& q) {
+  const std::map<std::string, std::string> queued = queued_jobs(plan, shot, q);
   if (queued.empty()) return;
   std::string ids;
-  for (const std::string& j : queued) ids += (ids.empty() ? "" : ", ") + j;
+  for (const auto& [job, name] : queued) ids += (ids.empty() ? "" : ", ") + job;
   throw Error(
       plan.shots[std::size_t(shot)].path,
       fmt::format("has jobs in the queue ({}); wait for them or run `emaki farm cancel`", ids));
 }
 
-std::string sbatch(const std::string& script_path) {
-  const ProcessResult r = run_process({"sbatch", "--parsable", script_path});
+// Submits a script from its farm folder: the script's relative --output lands there, and the
+// folder's path never has to fit an #SBATCH line.
+std::string sbatch(const std::string& script_path, const std::string& farm) {
+  const ProcessResult r = run_process({"sbatch", "--parsable", "--chdir=" + farm, script_path});
   if (r.exit_code != 0)
-    throw Error("sbatch",
-                fmt::format("refused '{}' ({}): {}", script_path, r.exit_code, first_line(r.err)));
+    throw Error("sbatch", fmt::format("refused '{}' ({}): {}", echo_path(script_path), r.exit_code,
+                                      first_line(r.err)));
   std::string id = r.out.substr(0, r.out.find_first_of(";\n"));
-  if (id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
-    throw Error("sbatch", fmt::format("printed no job id for '{}': {}", script_path, echo(r.out)));
+  if (id.empty() || id.size() > 18 || id.find_first_not_of("0123456789") != std::string::npos)
+    throw Error("sbatch",
+                fmt::format("printed no job id for '{}': {}", echo_path(script_path), echo(r.out)));
   return id;
+}
+
+// Cancels jobs of the submitting user, each only under the job name it was recorded with.
+void scancel(const std::map<std::string, std::string>& job_names) {
+  std::map<std::string, std::vector<std::string>> by_name;
+  for (const auto& [job, name] : job_names) by_name[name].push_back(job);
+  for (const auto& [name, ids] : by_name) {
+    std::vector<std::string> argv = {"scancel", "--user=" + user_id(), "--name=" + name};
+    argv.insert(argv.end(), ids.begin(), ids.end());
+    const ProcessResult r = run_process(argv);
+    if (r.exit_code != 0)
+      throw Error("scancel", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
+  }
+}
+
+// Submits one array; its records are on disk before the next array is queued, or it is
+// cancelled and the error names jobs.tsv.
+std::string submit_array(const std::string& farm, const std::string& path,
+                         const std::vector<const Task*>& tasks, const std::string& name) {
+  const std::string job = sbatch(path, farm);
+  try {
+    append_jobs(farm, tasks, job);
+  } catch (const Error& e) {
+    std::string cancelled = "it was cancelled";
+    try {
+      scancel({{job, name}});
+    } catch (const Error&) {
+      cancelled = "cancel it with scancel " + job;
+    }
+    throw Error(e.subject(), e.message() + "; " + cancelled);
+  }
+  return job;
 }
 
 }  // namespace
@@ -228,14 +318,14 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
           continue;
         }
         tasks.push_back(&t);
-        for (const std::string& a : t.after)
-          depends.insert(o.dry_run ? "{" + a + "}" : job_of_task.at(a));
+        for (const std::string& a : t.after) depends.insert(job_of_task.at(a));
       }
       if (tasks.empty()) continue;
       const std::string script = batch_script(plan, tasks, {depends.begin(), depends.end()}, o);
       ++out.jobs;
       out.tasks += int(tasks.size());
       if (o.dry_run) {
+        for (const Task* t : tasks) job_of_task[t->id] = "{" + job_name(plan, s, kind) + "}";
         out.scripts.push_back(script);
         continue;
       }
@@ -249,8 +339,7 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
       for (const Task* t : tasks)
         for (const char* f : {"/status/{}.exit", "/status/{}.exit.tmp", "/logs/{}.log"})
           fs::remove(farm + fmt::format(fmt::runtime(f), t->id));
-      const std::string job = sbatch(path);
-      append_jobs(farm, tasks, job);
+      const std::string job = submit_array(farm, path, tasks, job_name(plan, s, kind));
       for (const Task* t : tasks) job_of_task[t->id] = job;
       out.scripts.push_back(path);
     }
@@ -260,11 +349,16 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
 
 namespace {
 
-// The line of a failed task's log that says why: its last error line, else its last line.
+// The line of a failed task's log that says why: its last error line, else its last line. Only
+// the log's tail is read: a log of gigabytes (or /dev/zero in its place) costs no more.
 std::string error_line(const std::string& log) {
-  std::ifstream in(log);
-  std::string line, last, error;
-  while (std::getline(in, line)) {
+  const std::string text = read_file_tail(log, kLogTailBytes).value_or("");
+  std::string last, error;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    const std::string line = text.substr(start, end - start);
+    start = end + 1;
     if (line.empty()) continue;
     last = line;
     if (line.find("error") != std::string::npos) error = line;
@@ -274,25 +368,25 @@ std::string error_line(const std::string& log) {
 
 TaskStatus status_of(const Plan& plan, const Task& t,
                      const std::map<std::string, std::string>& jobs,
-                     const std::map<std::string, std::pair<std::string, std::string>>& q) {
+                     const std::map<std::string, QueuedJob>& q) {
   TaskStatus st;
   st.task = &t;
   const std::string farm = farm_folder(plan, t.shot);
   const auto job = jobs.find(t.id);
   if (job != jobs.end()) st.job = job->second;
-  if (const auto it = q.find(st.job); !st.job.empty() && it != q.end()) {
-    const std::string& state = it->second.first;
-    const bool pending = state == "PENDING";
+  if (const auto it = q.find(st.job);
+      !st.job.empty() && it != q.end() && it->second.name == job_name(plan, t.shot, t.kind)) {
+    const bool pending = it->second.state == "PENDING";
     st.state = pending ? TaskState::kPending : TaskState::kRunning;
-    st.detail = pending ? it->second.second : state;
+    st.detail = pending ? it->second.reason : it->second.state;
     return st;
   }
-  std::ifstream exit_file(farm + "/status/" + t.id + ".exit");
-  int code = -1;
-  if (exit_file >> code) {
+  const std::optional<std::string> exit_text =
+      read_state_file(farm + "/status/" + t.id + ".exit", kMaxSmallFileBytes);
+  if (const std::optional<int> code = exit_text ? parse_exit_code(*exit_text) : std::nullopt) {
     const std::string log = farm + "/logs/" + t.id + ".log";
-    st.state = code == 0 ? TaskState::kDone : TaskState::kFailed;
-    if (code != 0) st.detail = fmt::format("exit {}; {}: {}", code, log, error_line(log));
+    st.state = *code == 0 ? TaskState::kDone : TaskState::kFailed;
+    if (*code != 0) st.detail = fmt::format("exit {}; {}: {}", *code, log, error_line(log));
     return st;
   }
   if (t.done) {
@@ -343,17 +437,11 @@ std::optional<int> submitted_chunk(const Plan& plan) {
 
 int cancel(const Plan& plan) {
   const auto q = queue();
-  std::set<std::string> ids;
-  for (int s = 0; s < int(plan.shots.size()); ++s)
-    for (const auto& [task, element] : read_jobs(farm_folder(plan, s)))
-      if (q.count(element)) ids.insert(job_of(element));
-  if (ids.empty()) return 0;
-  std::vector<std::string> argv = {"scancel"};
-  argv.insert(argv.end(), ids.begin(), ids.end());
-  const ProcessResult r = run_process(argv);
-  if (r.exit_code != 0)
-    throw Error("scancel", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
-  return int(ids.size());
+  std::map<std::string, std::string> jobs;
+  for (int s = 0; s < int(plan.shots.size()); ++s) jobs.merge(queued_jobs(plan, s, q));
+  if (jobs.empty()) return 0;
+  scancel(jobs);
+  return int(jobs.size());
 }
 
 }  // namespace emaki::farm

@@ -2,7 +2,9 @@
 // do, each array `--dependency=afterok` on the arrays holding the tasks it waits for, job ids
 // recorded in the shot's output folder (farm/jobs.tsv), logs per task (farm/logs/TASK.log) and
 // each task's exit code (farm/status/TASK.exit). Shared storage is assumed: every node sees the
-// shot files, their inputs and the output folders under the same paths.
+// shot files, their inputs and the output folders under the same paths. Text from shot files and
+// options reaches a script only through farm/script_text.h; what is read back from the farm
+// folder and the queue goes through farm/farm_state.h.
 #pragma once
 
 #include <optional>
@@ -25,11 +27,15 @@ struct Submitted {
   int done = 0;                      // tasks left out as finished already
 };
 
-// Submits the plan's unfinished tasks. Throws emaki::Error naming a shot file when that shot
-// still has jobs in the queue, or the failing command when sbatch refuses a script.
+// Submits the plan's unfinished tasks, each array as `sbatch --chdir=OUTPUT/farm`. Throws
+// emaki::Error naming a shot file when that shot still has jobs in the queue, the value a script
+// cannot carry (script_text.h), the failing command when sbatch refuses a script, or jobs.tsv
+// when an array's records cannot be written (that array is then cancelled, no other submitted).
 Submitted submit(const shot::Plan& plan, const SlurmOptions& options);
 
-// A batch script for `tasks` (one array; all of one shot); `depends` are job ids.
+// A batch script for `tasks` (one array; all of one shot); `depends` are job ids. Throws
+// emaki::Error naming the shot file, its outputs.folder or the option holding text a script
+// cannot carry.
 std::string batch_script(const shot::Plan& plan, const std::vector<const shot::Task*>& tasks,
                          const std::vector<std::string>& depends, const SlurmOptions& options);
 
@@ -43,7 +49,8 @@ struct TaskStatus {
   std::string detail;  // a failed task's exit code, log and error line; a pending task's reason
 };
 
-// Every task's state, from the queue (squeue), the exit codes and the outputs on disk.
+// Every task's state, from the queue (the user's own jobs, under the shot's own job names), the
+// exit codes and the outputs on disk.
 std::vector<TaskStatus> status(const shot::Plan& plan);
 
 // The chunk (`--chunk`) the plan's shots were last submitted with, recorded by submit in
@@ -52,7 +59,8 @@ std::vector<TaskStatus> status(const shot::Plan& plan);
 // "chunk" when the shots were submitted with different chunks.
 std::optional<int> submitted_chunk(const shot::Plan& plan);
 
-// Cancels every queued job of the plan's shots (scancel). Returns the job arrays cancelled.
+// Cancels every queued job recorded for the plan's shots that is the user's and carries the
+// shot's own job name (scancel --user --name). Returns the job arrays cancelled.
 int cancel(const shot::Plan& plan);
 
 }  // namespace emaki::farm

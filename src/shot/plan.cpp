@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <unordered_map>
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/utf8.h"
 #include "io/file_store.h"
 #include "io/image_io.h"
 #include "shot/shot.h"
@@ -72,6 +74,19 @@ double exemplar_pixels(const pipeline::Shot& s) {
   return px;
 }
 
+// A shot's name in task ids: the file's stem, readable, and a digest (FNV-1a, 32 bits shown) of
+// its canonical path, so that d1/a.toml, d2/a.toml and a-2.toml differ and a shot keeps its ids
+// whichever other shots are planned beside it.
+std::string shot_name(const std::string& path) {
+  std::error_code ec;
+  fs::path canonical = fs::weakly_canonical(path, ec);
+  if (ec) canonical = fs::absolute(path).lexically_normal();
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (const char c : canonical.string())
+    h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
+  return fmt::format("{}-{:08x}", fs::path(path).stem().string(), uint32_t(h ^ (h >> 32)));
+}
+
 std::string frames_text(int a, int b) {
   return fmt::format("{}-{}", a, b);
 }
@@ -87,6 +102,7 @@ class Planner {
     const std::string& out = s.outputs.folder;
     const int first = s.source.first_frame, last = s.source.last_frame;
     exemplar_pixels_ = exemplar_pixels(s);
+    shot_tasks_ = plan_.tasks.size();
 
     const bool scene = s.source.kind == pipeline::SourceKind::kScene;
     // Each task is done when its own outputs are there under current manifests (what `emaki run`
@@ -99,6 +115,9 @@ class Planner {
     const bool need_cache = scene && !passes_done(first, last);
     const std::string prepare =
         add(index, TaskKind::kPrepare, "", first, last, {out}, {}, state.prepared(need_cache));
+    // A chunked task waits only for the tasks that make its own frames (chunks of every stage
+    // start at `first` and step by the chunk, so they line up); a temporal layer's task, which
+    // covers the shot, waits for every chunk. So the graph has O(frames / chunk) edges.
     std::vector<std::string> passes;
     if (scene)
       for (int a = first; a <= last; a += o_.chunk) {
@@ -106,16 +125,24 @@ class Planner {
         passes.push_back(add(index, TaskKind::kPasses, "", a, b, {out + "/passes"}, {prepare},
                              passes_done(a, b)));
       }
-    const std::vector<std::string> before_layers = scene ? passes : std::vector{prepare};
-    std::vector<std::string> layers;
+    const auto passes_of = [&](int chunk) {
+      return scene ? std::vector{passes[std::size_t(chunk)]} : std::vector{prepare};
+    };
+    std::vector<std::string> whole_layers;               // temporal: one task each
+    std::vector<std::vector<std::string>> chunk_layers(  // per chunk: the chunked layers' tasks
+        std::size_t((last - first) / o_.chunk + 1));
     for (const pipeline::Layer& l : s.layers) {
-      const int step = l.temporal.enabled ? last - first + 1 : o_.chunk;
+      const bool whole = l.temporal.enabled;
+      const int step = whole ? last - first + 1 : o_.chunk;
       for (int a = first; a <= last; a += step) {
         const int b = std::min(last, a + step - 1);
         bool done = true;
         for (int f = a; f <= b && done; ++f) done = state.has_layer(l, f);
-        layers.push_back(add(index, TaskKind::kLayer, l.name, a, b, {out + "/layers/" + l.name},
-                             before_layers, done));
+        const int chunk = (a - first) / o_.chunk;
+        const std::string id =
+            add(index, TaskKind::kLayer, l.name, a, b, {out + "/layers/" + l.name},
+                whole ? (scene ? passes : std::vector{prepare}) : passes_of(chunk), done);
+        (whole ? whole_layers : chunk_layers[std::size_t(chunk)]).push_back(id);
       }
     }
     std::vector<std::string> composites;
@@ -123,12 +150,17 @@ class Planner {
       const int b = std::min(last, a + o_.chunk - 1);
       bool done = true;
       for (int f = a; f <= b && done; ++f) done = state.has_frame(f);
+      std::vector<std::string> after = passes_of((a - first) / o_.chunk);
+      after.insert(after.end(), whole_layers.begin(), whole_layers.end());
+      const std::vector<std::string>& chunked = chunk_layers[std::size_t((a - first) / o_.chunk)];
+      after.insert(after.end(), chunked.begin(), chunked.end());
       composites.push_back(add(index, TaskKind::kComposite, "", a, b,
-                               {out + "/composite", out + "/layered"}, layers, done));
+                               {out + "/composite", out + "/layered"}, after, done));
     }
     // Previews are cheap and are remade whenever anything else is.
     bool all_done = true;
-    for (const Task& t : plan_.tasks) all_done = all_done && (t.shot != index || t.done);
+    for (std::size_t i = shot_tasks_; i < plan_.tasks.size(); ++i)
+      all_done = all_done && plan_.tasks[i].done;
     add(index, TaskKind::kPreviews, "", first, last, {out}, composites,
         all_done && previews_exist(s));
   }
@@ -163,8 +195,13 @@ class Planner {
     if (!layer.empty()) t.id += fmt::format(".{}", layer);
     if (kind == TaskKind::kPasses || kind == TaskKind::kLayer || kind == TaskKind::kComposite)
       t.id += fmt::format(".{}", frames_text(a, b));
-    t.argv = {o_.emaki, "task", task_kind_name(kind), ps.path};
-    if (!layer.empty()) t.argv.insert(t.argv.end(), {"--layer", layer});
+    // A path or layer name starting with '-' would read as an option of `emaki task`.
+    t.argv = {o_.emaki, "task", task_kind_name(kind),
+              ps.path.starts_with('-') ? "./" + ps.path : ps.path};
+    if (layer.starts_with('-'))
+      t.argv.push_back("--layer=" + layer);
+    else if (!layer.empty())
+      t.argv.insert(t.argv.end(), {"--layer", layer});
     if (kind != TaskKind::kPrepare && kind != TaskKind::kPreviews)
       t.argv.insert(t.argv.end(), {"--frames", frames_text(a, b)});
     t.threads = o_.threads;
@@ -173,20 +210,17 @@ class Planner {
     t.memory_mb = memory_estimate(ps.shot, exemplar_pixels_, kind);
     t.done = done;
     for (const std::string& id : after)
-      if (!find(id)->done) t.after.push_back(id);
+      if (!done_.at(id)) t.after.push_back(id);
+    done_[t.id] = t.done;
     plan_.tasks.push_back(std::move(t));
     return plan_.tasks.back().id;
-  }
-
-  const Task* find(const std::string& id) const {
-    for (const Task& t : plan_.tasks)
-      if (t.id == id) return &t;
-    return nullptr;
   }
 
   Plan& plan_;
   const PlanOptions& o_;
   double exemplar_pixels_ = 0;
+  std::size_t shot_tasks_ = 0;                  // the current shot's first task
+  std::unordered_map<std::string, bool> done_;  // task id -> done
 };
 
 }  // namespace
@@ -200,7 +234,7 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
                 fmt::format("must be in [1, 1024], got {}", options.threads));
   Plan p;
   p.chunk = options.chunk;
-  std::map<std::string, int> names;
+  std::map<std::string, std::string> names;  // name -> shot file
   std::map<std::string, std::string> folders;
   for (PlannedShot& s : shots) {
     const std::string folder = fs::weakly_canonical(s.shot.outputs.folder).string();
@@ -209,8 +243,11 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
                   fmt::format("'{}' and '{}' write the same output folder '{}'",
                               echo_path(it->second), echo_path(s.path), echo_path(folder)));
     folders[folder] = s.path;
-    if (s.name.empty()) s.name = fs::path(s.path).stem().string();
-    if (const int n = names[s.name]++; n > 0) s.name += fmt::format("-{}", n + 1);
+    if (s.name.empty()) s.name = shot_name(s.path);
+    if (const auto [it, added] = names.emplace(s.name, s.path); !added)
+      throw Error(Error::Field{"shots"},
+                  fmt::format("'{}' and '{}' both name their tasks '{}'; rename one",
+                              echo_path(it->second), echo_path(s.path), echo(s.name)));
     p.shots.push_back(std::move(s));
   }
   Planner planner(p, options);
@@ -226,7 +263,14 @@ Plan plan(const std::vector<std::string>& shot_paths, const PlanOptions& options
 
 namespace {
 
-std::string json_string(const std::string& s) {
+// A JSON string. JSON is Unicode text: a value that is not UTF-8 (a path's raw bytes) cannot be
+// carried faithfully, so it is an error naming `subject` and showing the text up to the bad byte.
+std::string json_string(const std::string& s, const std::string& subject) {
+  if (const std::size_t bad = first_invalid_utf8(s); bad != std::string::npos)
+    throw Error(subject, fmt::format("'{}...' is not UTF-8 text (byte {} is 0x{:02x}); plan "
+                                     "--json cannot carry it: rename it",
+                                     echo(std::string_view(s).substr(0, bad)), bad,
+                                     unsigned(static_cast<unsigned char>(s[bad]))));
   std::string out = "\"";
   for (const char c : s) {
     switch (c) {
@@ -249,9 +293,9 @@ std::string json_string(const std::string& s) {
   return out + "\"";
 }
 
-std::string json_strings(const std::vector<std::string>& v) {
+std::string json_strings(const std::vector<std::string>& v, const std::string& subject) {
   std::string out = "[";
-  for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + json_string(v[i]);
+  for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + json_string(v[i], subject);
   return out + "]";
 }
 
@@ -261,24 +305,29 @@ std::string plan_json(const Plan& plan) {
   std::string out = "{\n  \"format\": \"emaki-plan-1\",\n  \"shots\": [\n";
   for (std::size_t i = 0; i < plan.shots.size(); ++i) {
     const PlannedShot& s = plan.shots[i];
+    const std::string subject = echo_path(valid_utf8_or_marks(s.path));
     out += fmt::format(
         "    {{\"name\": {}, \"path\": {}, \"output_folder\": {}, \"frames\": [{}, {}], "
         "\"size\": [{}, {}]}}{}\n",
-        json_string(s.name), json_string(s.path), json_string(s.shot.outputs.folder),
-        s.shot.source.first_frame, s.shot.source.last_frame, s.shot.source.width,
-        s.shot.source.height, i + 1 < plan.shots.size() ? "," : "");
+        json_string(s.name, subject), json_string(s.path, subject),
+        json_string(s.shot.outputs.folder, subject + ": outputs.folder"), s.shot.source.first_frame,
+        s.shot.source.last_frame, s.shot.source.width, s.shot.source.height,
+        i + 1 < plan.shots.size() ? "," : "");
   }
   out += "  ],\n  \"tasks\": [\n";
   for (std::size_t i = 0; i < plan.tasks.size(); ++i) {
     const Task& t = plan.tasks[i];
+    const std::string subject =
+        echo_path(valid_utf8_or_marks(plan.shots[std::size_t(t.shot)].path));
     out += fmt::format(
         "    {{\"id\": {}, \"shot\": {}, \"kind\": \"{}\", \"layer\": {}, \"frames\": [{}, {}], "
         "\"argv\": {}, \"outputs\": {}, \"memory_mb\": {}, \"threads\": {}, \"after\": {}, "
         "\"done\": {}}}{}\n",
-        json_string(t.id), json_string(plan.shots[std::size_t(t.shot)].name),
-        task_kind_name(t.kind), t.layer.empty() ? "null" : json_string(t.layer), t.first_frame,
-        t.last_frame, json_strings(t.argv), json_strings(t.outputs), t.memory_mb, t.threads,
-        json_strings(t.after), t.done ? "true" : "false", i + 1 < plan.tasks.size() ? "," : "");
+        json_string(t.id, subject), json_string(plan.shots[std::size_t(t.shot)].name, subject),
+        task_kind_name(t.kind), t.layer.empty() ? "null" : json_string(t.layer, subject),
+        t.first_frame, t.last_frame, json_strings(t.argv, subject),
+        json_strings(t.outputs, subject), t.memory_mb, t.threads, json_strings(t.after, subject),
+        t.done ? "true" : "false", i + 1 < plan.tasks.size() ? "," : "");
   }
   return out + "  ]\n}\n";
 }

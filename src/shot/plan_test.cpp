@@ -1,13 +1,16 @@
 // The farm plan: which tasks a shot becomes, what each waits for, and what resuming leaves out.
 #include "shot/plan.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include "core/error.h"
+#include "core/utf8.h"
 #include "shot/shot.h"
 #include "tests/small_painting.h"
 
@@ -25,6 +28,7 @@ class PlanTest : public ::testing::Test {
             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
+    for (const char* sub : {"d1", "d2"}) fs::create_directories(dir_ / sub);
     test::write_small_painting(kData + "/stylit/source_style.png", painting());
   }
   std::string painting() const { return (dir_ / "painting.png").string(); }
@@ -62,20 +66,24 @@ TEST_F(PlanTest, TemporalLayersAreOneTaskOthersAreChunked) {
   PlanOptions o;
   o.chunk = 4;
   const Plan p = plan(std::vector<PlannedShot>{shot("a", 9)}, o);
-  EXPECT_EQ(ids(p, TaskKind::kPrepare), std::vector<std::string>{"a.prepare"});
+  const std::string a = p.shots[0].name;
+  EXPECT_EQ(ids(p, TaskKind::kPrepare), std::vector<std::string>{a + ".prepare"});
   EXPECT_EQ(ids(p, TaskKind::kPasses),
-            (std::vector<std::string>{"a.passes.0-3", "a.passes.4-7", "a.passes.8-9"}));
+            (std::vector<std::string>{a + ".passes.0-3", a + ".passes.4-7", a + ".passes.8-9"}));
   EXPECT_EQ(ids(p, TaskKind::kLayer),
-            (std::vector<std::string>{"a.layer.base.0-9", "a.layer.ink.0-3", "a.layer.ink.4-7",
-                                      "a.layer.ink.8-9"}));
+            (std::vector<std::string>{a + ".layer.base.0-9", a + ".layer.ink.0-3",
+                                      a + ".layer.ink.4-7", a + ".layer.ink.8-9"}));
   EXPECT_EQ(ids(p, TaskKind::kComposite).size(), 3u);
-  EXPECT_EQ(ids(p, TaskKind::kPreviews), std::vector<std::string>{"a.previews"});
-  // Each waits for the whole stage before it.
-  EXPECT_EQ(task(p, "a.passes.4-7").after, std::vector<std::string>{"a.prepare"});
-  EXPECT_EQ(task(p, "a.layer.ink.4-7").after, ids(p, TaskKind::kPasses));
-  EXPECT_EQ(task(p, "a.composite.0-3").after, ids(p, TaskKind::kLayer));
-  EXPECT_EQ(task(p, "a.previews").after, ids(p, TaskKind::kComposite));
-  const Task& base = task(p, "a.layer.base.0-9");
+  EXPECT_EQ(ids(p, TaskKind::kPreviews), std::vector<std::string>{a + ".previews"});
+  // A chunk waits for the tasks that make its frames; a temporal layer for every chunk.
+  EXPECT_EQ(task(p, a + ".passes.4-7").after, std::vector<std::string>{a + ".prepare"});
+  EXPECT_EQ(task(p, a + ".layer.ink.4-7").after, std::vector<std::string>{a + ".passes.4-7"});
+  EXPECT_EQ(task(p, a + ".layer.base.0-9").after, ids(p, TaskKind::kPasses));
+  EXPECT_EQ(
+      task(p, a + ".composite.4-7").after,
+      (std::vector<std::string>{a + ".passes.4-7", a + ".layer.base.0-9", a + ".layer.ink.4-7"}));
+  EXPECT_EQ(task(p, a + ".previews").after, ids(p, TaskKind::kComposite));
+  const Task& base = task(p, a + ".layer.base.0-9");
   EXPECT_EQ(base.argv[1], "task");
   EXPECT_EQ(base.argv[2], "layer");
   EXPECT_NE(std::find(base.argv.begin(), base.argv.end(), "0-9"), base.argv.end());
@@ -83,19 +91,55 @@ TEST_F(PlanTest, TemporalLayersAreOneTaskOthersAreChunked) {
   for (const Task& t : p.tasks) EXPECT_FALSE(t.done) << t.id;
 }
 
-TEST_F(PlanTest, ShotsGetUniqueNamesAndOwnTasks) {
+// d1/a.toml, d2/a.toml and a-2.toml: one stem, and a name the old "-2" suffix would have made.
+// Each gets its own task ids (stem plus a digest of its canonical path, the same in any plan)
+// and its own dependencies.
+TEST_F(PlanTest, ShotsWithOneStemGetDistinctStableNames) {
   PlanOptions o;
   o.chunk = 100;
-  std::vector<PlannedShot> shots = {shot("a", 3), shot("b", 5)};
-  shots[1].name = "a";  // two shots with one name are told apart
-  const Plan p = plan(std::move(shots), o);
-  ASSERT_EQ(p.shots.size(), 2u);
-  EXPECT_EQ(p.shots[1].name, "a-2");
-  EXPECT_EQ(ids(p, TaskKind::kPrepare), (std::vector<std::string>{"a.prepare", "a-2.prepare"}));
-  EXPECT_EQ(task(p, "a-2.layer.ink.0-5").after, std::vector<std::string>{"a-2.passes.0-5"});
+  const Plan p =
+      plan(std::vector<PlannedShot>{shot("d1/a", 3), shot("d2/a", 5), shot("a-2", 4)}, o);
+  ASSERT_EQ(p.shots.size(), 3u);
+  std::set<std::string> names;
+  for (const PlannedShot& s : p.shots) {
+    names.insert(s.name);
+    EXPECT_EQ(s.name.size(), fs::path(s.path).stem().string().size() + 9) << s.name;
+    EXPECT_EQ(s.name.rfind(fs::path(s.path).stem().string() + "-", 0), 0u) << s.name;
+  }
+  EXPECT_EQ(names.size(), 3u);
+  std::set<std::string> all;
+  for (const Task& t : p.tasks) EXPECT_TRUE(all.insert(t.id).second) << t.id;
+  for (const PlannedShot& s : p.shots) {
+    const int last = s.shot.source.last_frame;
+    EXPECT_EQ(task(p, fmt::format("{}.layer.ink.0-{}", s.name, last)).after,
+              std::vector<std::string>{fmt::format("{}.passes.0-{}", s.name, last)});
+    EXPECT_EQ(task(p, s.name + ".previews").after,
+              std::vector<std::string>{fmt::format("{}.composite.0-{}", s.name, last)});
+  }
+  // Planned alone, a shot keeps its name: status and cancel find what submit recorded.
+  EXPECT_EQ(plan(std::vector<PlannedShot>{shot("d2/a", 5)}, o).shots[0].name, p.shots[1].name);
+  std::vector<PlannedShot> twins = {shot("b", 3), shot("c", 3)};
+  twins[0].name = twins[1].name = "same";
+  EXPECT_THROW(plan(std::move(twins), o), Error);
   const std::string json = plan_json(p);
   EXPECT_NE(json.find("\"format\": \"emaki-plan-1\""), std::string::npos);
-  EXPECT_NE(json.find("\"id\": \"a-2.previews\""), std::string::npos);
+  EXPECT_NE(json.find("\"id\": \"" + p.shots[2].name + ".previews\""), std::string::npos);
+}
+
+// JSON is Unicode: a path that is not UTF-8 is an error naming the shot, never invalid JSON.
+TEST_F(PlanTest, JsonRefusesPathsThatAreNotUtf8) {
+  PlannedShot latin1 = shot("a", 1);  // TOML text is UTF-8; a file name need not be
+  latin1.path = (dir_ / "caf\xe9.toml").string();
+  const Plan p = plan(std::vector<PlannedShot>{latin1}, PlanOptions{});
+  try {
+    plan_json(p);
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_NE(e.message().find("is not UTF-8"), std::string::npos) << e.what();
+    EXPECT_EQ(first_invalid_utf8(e.what()), std::string::npos) << e.what();
+  }
+  const Plan ok = plan(std::vector<PlannedShot>{shot("caf\xc3\xa9 q", 1)}, PlanOptions{});
+  EXPECT_NE(plan_json(ok).find("caf\xc3\xa9 q"), std::string::npos);
 }
 
 TEST_F(PlanTest, BadOptionsAndSharedFoldersAreErrors) {
@@ -133,14 +177,15 @@ TEST_F(PlanTest, ResumeLeavesOutFinishedWork) {
   r.composite = false;
   run(s.shot, r);
   const Plan p = plan(std::vector<PlannedShot>{s}, o);
-  EXPECT_TRUE(task(p, "a.prepare").done);
-  EXPECT_TRUE(task(p, "a.passes.0-1").done);
-  EXPECT_FALSE(task(p, "a.passes.2-3").done);
-  EXPECT_TRUE(task(p, "a.layer.ink.0-1").done);
-  EXPECT_FALSE(task(p, "a.layer.ink.2-3").done);
-  EXPECT_FALSE(task(p, "a.layer.base.0-3").done);
-  EXPECT_TRUE(task(p, "a.passes.2-3").after.empty());  // prepare is done
-  EXPECT_EQ(task(p, "a.layer.ink.2-3").after, std::vector<std::string>{"a.passes.2-3"});
+  const std::string a = p.shots[0].name;
+  EXPECT_TRUE(task(p, a + ".prepare").done);
+  EXPECT_TRUE(task(p, a + ".passes.0-1").done);
+  EXPECT_FALSE(task(p, a + ".passes.2-3").done);
+  EXPECT_TRUE(task(p, a + ".layer.ink.0-1").done);
+  EXPECT_FALSE(task(p, a + ".layer.ink.2-3").done);
+  EXPECT_FALSE(task(p, a + ".layer.base.0-3").done);
+  EXPECT_TRUE(task(p, a + ".passes.2-3").after.empty());  // prepare is done
+  EXPECT_EQ(task(p, a + ".layer.ink.2-3").after, std::vector<std::string>{a + ".passes.2-3"});
 
   // All of it run: every task is done, previews included.
   Request all;

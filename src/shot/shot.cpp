@@ -98,7 +98,18 @@ int render_passes(const pipeline::Shot& shot, const Request& request) {
 
 std::vector<std::string> write_previews(const pipeline::Shot& shot, const Request& request) {
   io::FileStore store(shot, io::StoreMode::kReadFinished, access(request));
-  return io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
+  std::vector<std::string> written =
+      io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
+  // Asked for previews alone, a folder without them all composited is an error, not a success
+  // that wrote nothing.
+  const bool wanted =
+      shot.outputs.mp4 || (shot.outputs.contact_sheet && shot.outputs.composite_png);
+  if (wanted && written.empty())
+    throw Error(shot.outputs.folder,
+                fmt::format("frames {}-{} are not all composited under the shot's settings: no "
+                            "previews to make; run the shot (or its composite tasks) first",
+                            shot.source.first_frame, shot.source.last_frame));
+  return written;
 }
 
 // The layer and frame range a measure over finished frames (qa flicker, qa ghost) reads.

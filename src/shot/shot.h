@@ -61,7 +61,8 @@ void prepare(const pipeline::Shot& shot);
 int render_passes(const pipeline::Shot& shot, const Request& request);
 
 // The contact sheet and MP4 the shot asks for, once every frame is composited. Returns the files
-// written (none while frames are missing).
+// written; throws Error naming the output folder when the shot asks for previews and its frames
+// are not all composited under its settings (an unprepared or unfinished folder).
 std::vector<std::string> write_previews(const pipeline::Shot& shot, const Request& request);
 
 struct FlickerResult {

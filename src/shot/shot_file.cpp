@@ -143,6 +143,9 @@ void parse_exemplars(const toml::table& exemplars, const PathContext& ctx, Shot&
 void parse_layers(const toml::table& layers, Shot& shot) {
   for (const auto& [line, name] : names_in_file_order(layers)) {
     const std::string key = "layers." + echo(name);
+    if (name.empty())
+      throw Error("layers.\"\"",
+                  "a layer needs a name (letters, digits, '_' and '-'; it names files)");
     const toml::table& t = subtable(layers, name, key);
     for (char c : name)
       if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'))

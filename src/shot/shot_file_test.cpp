@@ -104,6 +104,8 @@ TEST(ShotFile, ErrorsNameTheKeyPath) {
       {minimal("[layers.a]\nexemplar = \"sphere\"\n"), "layers.a.guides: is required"},
       {minimal("[layers.\"bad name\"]\nkind = \"base\"\nexemplar = \"sphere\"\n"),
        "layers.bad name:"},
+      {minimal("[layers.\"\"]\nkind = \"base\"\nexemplar = \"sphere\"\n"),
+       "layers.\"\": a layer needs a name"},
   });
 }
 
