@@ -1,7 +1,10 @@
 // Work neither lost nor needlessly redone (issue 28): a full disk fails a run with one line naming
 // the file and never commits a file cut short; a damaged output or pass-cache file is made again
-// (by `run`, and by `run --force`) instead of stopping every later run.
+// (by `run`, and by `run --force`) instead of stopping every later run; and the same shot reached
+// through another spelling of its path (relative, absolute, through a linked folder) finds its
+// finished frames current and redoes nothing.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -191,6 +194,57 @@ TEST_F(ResumeSafety, AFullDiskNeverCommitsAFileCutShort) {
       EXPECT_TRUE(test::slurp_file(disk / name) == bytes) << name << " after filling to " << k;
   }
   EXPECT_GT(failed, 5);
+}
+
+// ---- the same shot by another path ----
+
+struct Stamp {
+  ino_t inode = 0;
+  int64_t mtime_ns = 0;
+  bool operator==(const Stamp&) const = default;
+};
+
+std::map<std::string, Stamp> stamps(const fs::path& folder) {
+  std::map<std::string, Stamp> out;
+  for (const auto& e : fs::recursive_directory_iterator(folder)) {
+    struct stat st {};
+    // The lock file names each run's holder: it is written by every run.
+    if (!e.is_regular_file() || e.path().filename() == ".emaki.lock" ||
+        ::stat(e.path().c_str(), &st) != 0)
+      continue;
+    out[fs::relative(e.path(), folder).string()] = {
+        st.st_ino, int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec};
+  }
+  return out;
+}
+
+// Run by a relative path, then by the absolute one, through a linked folder and from another
+// folder: every frame is already finished and no file is touched. Before, manifests held the
+// paths as spelled and the second run deleted and redid every frame.
+TEST_F(ResumeSafety, AnotherSpellingOfTheShotsPathRedoesNothing) {
+  expect_ok(emaki("run shot.toml"));
+  const auto before = stamps(dir_ / "shot/out");
+  ASSERT_GT(before.size(), 10u);
+  fs::create_directory_symlink(dir_ / "shot", dir_ / "linked");
+  for (const auto& [args, cwd] : std::vector<std::pair<std::string, fs::path>>{
+           {"run " + p("shot/shot.toml"), dir_},
+           {"run " + p("linked/shot.toml"), "/"},
+           {"run shot/shot.toml", dir_},
+           {"run ../linked/./shot.toml", dir_ / "shot"}}) {
+    const test::CliResult r = emaki(args, cwd);
+    expect_ok(r);
+    EXPECT_NE(r.err.find("0 layer-frames synthesized, 6 already finished, 0 frames composited"),
+              std::string::npos)
+        << args << ": " << r.err;
+    const auto after = stamps(dir_ / "shot/out");
+    for (const auto& [name, stamp] : before)
+      EXPECT_TRUE(after.count(name) && after.at(name) == stamp) << args << ": " << name;
+  }
+  // The farm's plan, given absolute paths, finds the shot finished.
+  const test::CliResult plan = emaki("plan --json " + p("linked/shot.toml"), "/");
+  expect_ok(plan);
+  EXPECT_EQ(plan.out.find("\"done\": false"), std::string::npos) << plan.out;
+  EXPECT_NE(plan.out.find("\"done\": true"), std::string::npos) << plan.out;
 }
 
 }  // namespace

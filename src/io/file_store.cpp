@@ -123,9 +123,9 @@ FileStore::Manifested FileStore::manifested(const std::string& dir, Manifest wan
   FileStore::Manifested m;
   m.want = std::move(want);
   const auto have = read_manifest((fs::path(dir) / kManifest).string());
-  m.current = have && *have == m.want;
+  m.current = have && manifest_current(*have, m.want);
   if (!m.current)
-    m.stale = have                           ? manifest_difference(*have, m.want)
+    m.stale = have                           ? manifest_change(*have, m.want)
               : any_frame(dir, prefix, exts) ? "no record of the settings that made it"
                                              : "";
   return m;
@@ -439,7 +439,7 @@ std::unique_ptr<pipeline::FrameSource> with_pass_cache(
     const Shot& shot, std::unique_ptr<pipeline::FrameSource> frames) {
   if (shot.source.kind != pipeline::SourceKind::kScene) return frames;
   const auto have = read_manifest((fs::path(shot.outputs.folder) / "passes" / kManifest).string());
-  if (!have || *have != passes_manifest(shot)) return frames;
+  if (!have || !manifest_current(*have, passes_manifest(shot))) return frames;
   return std::make_unique<CachedFrames>(shot, std::move(frames));
 }
 
