@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "cli_run.h"
+#include "tests/small_painting.h"
+#include "tests/textured_triangle.h"
 
 namespace {
 
@@ -251,6 +253,30 @@ TEST_F(HostileGltf, LongNamesAreCut) {
 TEST_F(HostileGltf, LongDataUriInTinygltfMessage) {
   const std::string uri = "data:application/octet-stream;base64," + std::string(1 << 20, 'A');
   expect_refused(write("longuri.gltf", triangle(uri)), "not a valid glTF file");
+}
+
+// source.objects: 256 objects of one file whose 2048 x 2048 texture decodes to 64 MiB, half of
+// them through a link to it. The file is loaded once and its texture held once, so the run fits
+// the 2 GiB bound; before, each link was another file and every object cloned the texture
+// (16 GiB).
+TEST_F(HostileGltf, ACrowdOfOneTexturedFileHoldsItsTextureOnce) {
+  const std::string tri = emaki::test::write_textured_triangle(dir_, 2048);
+  fs::create_symlink(tri, dir_ / "link.gltf");
+  emaki::test::write_small_painting(std::string(EMAKI_TEST_DATA) + "/stylit/source_style.png",
+                                    (dir_ / "painting.png").string());
+  std::string text = "[source]\nframes = [0, 0]\nsize = [32, 24]\naa = 1\n";
+  for (int i = 0; i < 256; ++i)
+    text += "[[source.objects]]\nscene = \"" + std::string(i % 2 ? "tri.gltf" : "link.gltf") +
+            "\"\ntranslate = [" + std::to_string(i % 16) + ", " + std::to_string(i / 16) + ", 0]\n";
+  text +=
+      "[exemplars.sphere]\npainting = \"painting.png\"\n[layers.base]\nkind = \"base\"\n"
+      "exemplar = \"sphere\"\n[outputs]\nfolder = \"out\"\nmp4 = false\n"
+      "contact_sheet = false\n";
+  const fs::path shot = write("crowd.toml", text);
+  const CliResult r = run_cli(kEmaki, {"run", shot.string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err.substr(0, 2000);
+  EXPECT_EQ(r.signal, 0);
+  EXPECT_TRUE(fs::exists(dir_ / "out/composite/frame_0000.png"));
 }
 
 }  // namespace

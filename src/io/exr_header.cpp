@@ -1,11 +1,14 @@
 #include "io/exr_header.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -33,10 +36,18 @@ class Source {
     pos_ += n;
     return true;
   }
+  uint64_t position() const { return pos_; }
+  // Reads n bytes at `offset` (false past the end); the sequential position is lost after it.
+  bool read_at(uint64_t offset, void* out, uint64_t n) {
+    if (offset > size_ || n > size_ - offset || !read_at_raw(offset, out, n)) return false;
+    pos_ = offset + n;
+    return true;
+  }
 
  private:
   virtual bool read_raw(void* out, uint64_t n) = 0;
   virtual bool skip_raw(uint64_t n) = 0;
+  virtual bool read_at_raw(uint64_t offset, void* out, uint64_t n) = 0;
   uint64_t size_;
   uint64_t pos_ = 0;
 };
@@ -55,6 +66,11 @@ class MemorySource final : public Source {
     at_ += n;
     return true;
   }
+  bool read_at_raw(uint64_t offset, void* out, uint64_t n) override {
+    std::memcpy(out, data_ + offset, n);
+    at_ = offset + n;
+    return true;
+  }
   const unsigned char* data_;
   uint64_t at_ = 0;
 };
@@ -68,6 +84,10 @@ class FileSource final : public Source {
   bool skip_raw(uint64_t n) override {
     return n <= uint64_t(std::numeric_limits<long>::max()) &&
            std::fseek(f_, long(n), SEEK_CUR) == 0;
+  }
+  bool read_at_raw(uint64_t offset, void* out, uint64_t n) override {
+    return offset <= uint64_t(std::numeric_limits<long>::max()) &&
+           std::fseek(f_, long(offset), SEEK_SET) == 0 && std::fread(out, 1, n, f_) == n;
   }
   std::FILE* f_;
 };
@@ -101,7 +121,19 @@ class Walker {
  public:
   Walker(Source& in, const std::string& subject) : in_(in), subject_(subject) {}
 
-  void run() {
+  // The headers, then (`chunks`) the offset tables and every chunk they point at.
+  void run(bool chunks) {
+    headers();
+    if (chunks) check_chunks();
+  }
+
+ private:
+  struct PartChunks {
+    uint64_t count = 0;
+    bool tiled = false;
+  };
+
+  void headers() {
     unsigned char magic[4];
     if (!in_.read(magic, 4) || !has_exr_magic(magic, 4)) fail("not an OpenEXR file");
     const uint32_t version = u32();
@@ -124,9 +156,14 @@ class Walker {
       }
       if (++parts > kMaxParts)
         fail("more than " + std::to_string(kMaxParts) + " parts (subimages)");
-      chunks += check_part(p, multipart ? p.type == "tiledimage" : tiled, parts - 1);
+      const bool part_tiled = multipart ? p.type == "tiledimage" : tiled;
+      const uint64_t n = check_part(p, part_tiled, parts - 1);
+      chunks += n;
+      // The table is as long as the part's chunkCount when it has one (multipart files do).
+      parts_.push_back({p.chunk_count ? uint64_t(*p.chunk_count) : n, part_tiled});
       if (!multipart) break;
     }
+    multipart_ = multipart;
     // Each chunk has an 8-byte entry in the offset tables that follow the headers; OpenEXR
     // allocates those tables from the header before reading them.
     if (chunks > in_.size() / 8)
@@ -134,7 +171,45 @@ class Walker {
            " chunks, more than the file can hold offsets for (the file is truncated or corrupt)");
   }
 
- private:
+  // The offset tables that follow the headers: every offset must point past them into the file,
+  // and the chunk that starts last must end within it. A write cut short (a full disk) ends the
+  // file early, so the last chunk is the one it cuts; OpenEXR writes the tables last, and a file
+  // whose tables were never written holds zeros there. (A tiled part's mipmap levels are not
+  // counted: their entries, further on, are not checked.)
+  void check_chunks() {
+    const uint64_t tables = in_.position();
+    uint64_t total = 0;
+    for (const PartChunks& p : parts_) total += p.count;  // each <= size / 8: no overflow
+    if (total > in_.size() / 8 || tables + 8 * total > in_.size())
+      fail("the file ends inside its chunk offset table (the file is truncated)");
+    const uint64_t data_start = tables + 8 * total;
+    uint64_t last = 0, last_prefix = 0;
+    for (std::size_t part = 0; part < parts_.size(); ++part) {
+      // Before a chunk's byte count: its part number (multipart), its y or its tile coordinates.
+      const uint64_t prefix = (multipart_ ? 4 : 0) + (parts_[part].tiled ? 16 : 4);
+      for (uint64_t c = 0; c < parts_[part].count; ++c) {
+        unsigned char b[8];
+        if (!in_.read(b, 8)) fail("cannot read the chunk offset table");
+        uint64_t offset = 0;
+        for (int k = 7; k >= 0; --k) offset = offset << 8 | b[k];
+        if (offset < data_start || offset >= in_.size())
+          fail(
+              fmt::format("chunk {}{} is at byte {}, outside the file's {} bytes of data (the "
+                          "file is truncated)",
+                          c, part > 0 ? fmt::format(" of part {}", part) : "", offset, in_.size()));
+        if (offset >= last) last = offset, last_prefix = prefix;
+      }
+    }
+    if (total == 0) return;
+    unsigned char n[4];
+    if (last > in_.size() - last_prefix || !in_.read_at(last + last_prefix, n, 4))
+      fail("the last chunk is cut short (the file is truncated)");
+    const int32_t bytes =
+        int32_t(uint32_t(n[0]) | uint32_t(n[1]) << 8 | uint32_t(n[2]) << 16 | uint32_t(n[3]) << 24);
+    if (bytes < 0 || uint64_t(bytes) > in_.size() - (last + last_prefix + 4))
+      fail("the last chunk ends past the end of the file (the file is truncated)");
+  }
+
   [[noreturn]] void fail(const std::string& message) const {
     throw Error(subject_, "EXR header: " + message);
   }
@@ -309,6 +384,8 @@ class Walker {
 
   Source& in_;
   const std::string& subject_;
+  std::vector<PartChunks> parts_;
+  bool multipart_ = false;
 };
 
 }  // namespace
@@ -320,15 +397,32 @@ bool has_exr_magic(const unsigned char* bytes, std::size_t n) {
 
 void check_exr_header(const unsigned char* data, std::size_t size, const std::string& subject) {
   MemorySource in(data, size);
-  Walker(in, subject).run();
+  Walker(in, subject).run(false);
 }
 
-void check_exr_header(std::FILE* file, const std::string& subject) {
+namespace {
+
+void walk_file(std::FILE* file, const std::string& subject, bool chunks) {
   if (std::fseek(file, 0, SEEK_END) != 0) throw Error(subject, "cannot read the file");
   const long size = std::ftell(file);
   if (size < 0 || std::fseek(file, 0, SEEK_SET) != 0) throw Error(subject, "cannot read the file");
   FileSource in(file, uint64_t(size));
-  Walker(in, subject).run();
+  Walker(in, subject).run(chunks);
+}
+
+}  // namespace
+
+void check_exr_header(std::FILE* file, const std::string& subject) {
+  walk_file(file, subject, false);
+}
+
+void check_exr_complete(const unsigned char* data, std::size_t size, const std::string& subject) {
+  MemorySource in(data, size);
+  Walker(in, subject).run(true);
+}
+
+void check_exr_complete(std::FILE* file, const std::string& subject) {
+  walk_file(file, subject, true);
 }
 
 }  // namespace emaki::io::detail

@@ -25,4 +25,10 @@ bool has_exr_magic(const unsigned char* bytes, std::size_t n);
 void check_exr_header(const unsigned char* data, std::size_t size, const std::string& subject);
 void check_exr_header(std::FILE* file, const std::string& subject);
 
+// The header checks above, then the chunk offset tables: every chunk they list must start after
+// them and end within the file. What a writer cut short (a full disk, a killed process) leaves:
+// OpenEXR writes the table last and reports no error when its final writes fail.
+void check_exr_complete(const unsigned char* data, std::size_t size, const std::string& subject);
+void check_exr_complete(std::FILE* file, const std::string& subject);
+
 }  // namespace emaki::io::detail

@@ -123,9 +123,9 @@ FileStore::Manifested FileStore::manifested(const std::string& dir, Manifest wan
   FileStore::Manifested m;
   m.want = std::move(want);
   const auto have = read_manifest((fs::path(dir) / kManifest).string());
-  m.current = have && *have == m.want;
+  m.current = have && manifest_current(*have, m.want);
   if (!m.current)
-    m.stale = have                           ? manifest_difference(*have, m.want)
+    m.stale = have                           ? manifest_change(*have, m.want)
               : any_frame(dir, prefix, exts) ? "no record of the settings that made it"
                                              : "";
   return m;
@@ -225,8 +225,7 @@ bool FileStore::prepared(bool with_pass_cache) const {
 }
 
 bool FileStore::has_passes(int frame) const {
-  std::error_code ec;
-  return passes_.current && fs::is_regular_file(paths_.passes_exr(frame), ec);
+  return passes_.current && image_file_complete(paths_.passes_exr(frame));
 }
 
 void FileStore::write_passes(int frame, ImageView<const float> passes) {
@@ -258,9 +257,9 @@ bool FileStore::has_layer(const pipeline::Layer& layer, int frame) const {
                   fmt::format("was made with other settings ({}); {}", m.stale, kRedoHint));
     return false;
   }
-  std::error_code ec;
-  if (!fs::is_regular_file(paths_.layer_exr(layer.name, frame), ec)) return false;
-  return !shot_.outputs.layer_png || fs::is_regular_file(paths_.layer_png(layer.name, frame), ec);
+  // A file cut short (a full disk, a killed copy) is not finished: it is made again.
+  if (!image_file_complete(paths_.layer_exr(layer.name, frame))) return false;
+  return !shot_.outputs.layer_png || image_file_complete(paths_.layer_png(layer.name, frame));
 }
 
 Image<float> FileStore::read_layer(const pipeline::Layer& layer, int frame) const {
@@ -337,11 +336,10 @@ Image<int32_t> FileStore::read_field(const pipeline::Layer& layer, int frame,
 
 bool FileStore::has_frame(int frame) const {
   if (!frames_.current) return false;
-  std::error_code ec;
   const pipeline::Outputs& o = shot_.outputs;
-  if (o.composite_png && !fs::is_regular_file(paths_.composite_png(frame), ec)) return false;
-  if (o.composite_exr && !fs::is_regular_file(paths_.composite_exr(frame), ec)) return false;
-  if (o.layered_exr && !fs::is_regular_file(paths_.layered_exr(frame), ec)) return false;
+  if (o.composite_png && !image_file_complete(paths_.composite_png(frame))) return false;
+  if (o.composite_exr && !image_file_complete(paths_.composite_exr(frame))) return false;
+  if (o.layered_exr && !image_file_complete(paths_.layered_exr(frame))) return false;
   return true;
 }
 
@@ -412,11 +410,17 @@ class CachedFrames : public pipeline::FrameSource {
         width_(shot.source.width),
         height_(shot.source.height),
         inner_(std::move(inner)) {}
+  // A cached frame that is missing, cut short or unreadable is rendered instead (the cache holds
+  // exactly what rendering gives): a damaged cache never stops a run, `--force` or not.
   Image<float> passes(int frame) const override {
     const std::string file = paths_.passes_exr(frame);
-    std::error_code ec;
-    if (!fs::is_regular_file(file, ec)) return inner_->passes(frame);
-    Image<float> img = read_image_float(file, ReadOptions{render::channel_names()});
+    if (!image_file_complete(file)) return inner_->passes(frame);
+    Image<float> img;
+    try {
+      img = read_image_float(file, ReadOptions{render::channel_names()});
+    } catch (const Error&) {
+      return inner_->passes(frame);
+    }
     if (img.width() != width_ || img.height() != height_)
       throw Error(file, fmt::format("is {}x{}, the shot makes {}x{}; {}", img.width(), img.height(),
                                     width_, height_, kRedoHint));
@@ -435,7 +439,7 @@ std::unique_ptr<pipeline::FrameSource> with_pass_cache(
     const Shot& shot, std::unique_ptr<pipeline::FrameSource> frames) {
   if (shot.source.kind != pipeline::SourceKind::kScene) return frames;
   const auto have = read_manifest((fs::path(shot.outputs.folder) / "passes" / kManifest).string());
-  if (!have || *have != passes_manifest(shot)) return frames;
+  if (!have || !manifest_current(*have, passes_manifest(shot))) return frames;
   return std::make_unique<CachedFrames>(shot, std::move(frames));
 }
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <optional>
 
 #include "core/limits.h"
@@ -20,10 +21,9 @@ float srgb_to_linear(float c) {
 // tinygltf's decoded 8- or 16-bit grey, grey+alpha, RGB or RGBA pixels as linear float RGBA
 // (the colour channels are sRGB-encoded in glTF, alpha is linear).
 scene::Texture to_linear_rgba(const tinygltf::Image& img, int comps, int bytes) {
-  scene::Texture out;
-  out.rgba.reset(img.width, img.height, 4);
+  Image<float> rgba(img.width, img.height, 4);
   for (int y = 0; y < img.height; ++y) {
-    float* row = out.rgba.row(y);
+    float* row = rgba.row(y);
     for (int x = 0; x < img.width; ++x) {
       float v[4] = {0, 0, 0, 1};
       for (int c = 0; c < comps; ++c) {
@@ -44,6 +44,8 @@ scene::Texture to_linear_rgba(const tinygltf::Image& img, int comps, int bytes) 
       row[4 * x + 3] = v[3];
     }
   }
+  scene::Texture out;
+  out.rgba = std::make_shared<const Image<float>>(std::move(rgba));
   return out;
 }
 

@@ -276,6 +276,26 @@ void check_writable(const std::string& path) {
   if (fs::is_directory(path, ec)) throw Error(path, "is a folder, not a file name");
 }
 
+namespace {
+
+// A file's structure checked to its end without decoding its pixels (PNG, EXR); other formats
+// are read back whole. Throws emaki::Error(subject).
+void check_structure(const std::string& file, const std::string& ext, const std::string& subject) {
+  if (ext == ".png") return detail::check_png_complete(file, 0, subject);
+  if (ext == ".exr") {
+    std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(file.c_str(), "rb"), &std::fclose);
+    if (!f) throw Error(subject, "cannot open for reading");
+    return detail::check_exr_complete(f.get(), subject);
+  }
+  AnyImage ignored;
+  std::lock_guard lock(detail::oiio_mutex());
+  if (std::string e = detail::oiio_backend(subject).read({file}, {}, max_pixels(), ignored);
+      !e.empty())
+    throw Error(subject, e);
+}
+
+}  // namespace
+
 void write_image(const std::string& path, ImageView<const float> image,
                  const WriteOptions& options) {
   check_writable(path);
@@ -322,15 +342,33 @@ void write_image(const std::string& path, ImageView<const float> image,
       ::close(fd);
       throw Error(path, "cannot open for writing");
     }
-    detail::write_png(file, image, type == 1, path);
-  } else {
+    const uint64_t bytes = detail::write_png(file, image, type == 1, path);
+    tmp.commit([&](const std::string& t) { detail::check_png_complete(t, bytes, path); });
+    return;
+  }
+  {
     std::lock_guard lock(detail::oiio_mutex());
     if (std::string e =
             detail::oiio_backend(path).write(tmp.path(), image, options.channel_names, type);
         !e.empty())
       throw Error(path, e);
   }
-  tmp.commit();
+  // OpenEXR reports success when its last writes (the chunk table) fail on a full disk: what it
+  // wrote is read back before it may replace the target.
+  tmp.commit([&](const std::string& t) { check_structure(t, ext, path); });
+}
+
+bool image_file_complete(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) == 0 || ec) return false;
+  const std::string ext = lower_ext(path);
+  if (ext != ".png" && ext != ".exr") return true;
+  try {
+    check_structure(path, ext, path);
+    return true;
+  } catch (const Error&) {
+    return false;
+  }
 }
 
 }  // namespace emaki::io

@@ -62,9 +62,17 @@ struct WriteOptions {
   std::vector<std::string> channel_names;  // EXR channel names; default R,G,B,A / Y
 };
 
-// Writes a float image (values in [0,1] for integer formats, clamped and rounded). Atomic.
+// Writes a float image (values in [0,1] for integer formats, clamped and rounded). Atomic, and
+// verified before the rename: a write the disk took only part of (a full disk) is an error naming
+// `path` that leaves any file already there as it was (io/output_store.h TempFile::commit).
 void write_image(const std::string& path, ImageView<const float> image,
                  const WriteOptions& options = {});
+
+// True when `path` is a non-empty regular file and, for PNG and EXR, whole to its end: a PNG
+// that ends with its end chunk, an EXR whose chunk table lies in the file and points at chunks
+// that do. Cheap (no pixel is decoded): what the output store asks before it counts a frame as
+// finished, so that a file cut short by a full disk or a killed copy is made again.
+bool image_file_complete(const std::string& path);
 
 // True when the file extension names a format we can write.
 bool is_writable_extension(const std::string& path);

@@ -241,6 +241,29 @@ TEST_F(ImageIo, EveryFuzzSeedReadsTheSameFromFileAndMemory) {
   EXPECT_GE(files, 20);
 }
 
+// What the output store asks before it counts a frame finished: every valid seed (scanline,
+// tiled, mipmapped, multipart EXR; PNG) is whole, and the same file cut short by a byte, or to
+// half, is not (a mipmapped file's lower levels excepted: their chunks are not listed).
+TEST_F(ImageIo, EveryFuzzSeedIsCompleteAndNotWhenCutShort) {
+  int cut = 0;
+  for (const char* folder : {"png", "exr"})
+    for (const auto& e :
+         fs::directory_iterator(fs::path(EMAKI_SOURCE_DIR) / "fuzz" / "corpus" / folder)) {
+      SCOPED_TRACE(e.path().string());
+      const std::string name = e.path().filename().string();
+      const std::string bytes = slurp(e.path().string());
+      EXPECT_TRUE(image_file_complete(e.path().string()));
+      if (name.find("mip") != std::string::npos) continue;
+      for (std::size_t keep : {bytes.size() - 1, bytes.size() / 2}) {
+        const std::string copy = p(name);
+        std::ofstream(copy, std::ios::binary).write(bytes.data(), std::streamsize(keep));
+        EXPECT_FALSE(image_file_complete(copy)) << keep;
+        ++cut;
+      }
+    }
+  EXPECT_GE(cut, 30);
+}
+
 // A pixel count within the budget is not enough: Image pads each row to 64 bytes, so a
 // 1 x 2^28 image would take 16 GiB.
 TEST(ReadLimits, RowPaddingCountsAgainstTheBudget) {

@@ -84,9 +84,15 @@ void TempFile::write(const void* data, std::size_t size) {
   while (done < size) {
     const ssize_t n = ::write(fd_, p + done, size - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw Error(subject_, "write failed (disk full?)");
+    if (n <= 0)
+      fail_unsaved(n < 0 ? std::strerror(errno) : "the disk took no more bytes (disk full?)");
     done += std::size_t(n);
   }
+  written_ += size;
+}
+
+void TempFile::fail_unsaved(const std::string& why) const {
+  throw Error(subject_, fmt::format("could not be written ({}); nothing was replaced", why));
 }
 
 TempFile::~TempFile() {
@@ -106,20 +112,40 @@ int TempFile::release_fd() {
   return fd;
 }
 
-void TempFile::commit() {
+void TempFile::commit(const std::function<void(const std::string& path)>& verify) {
   // Writers that take a path (OpenImageIO, ffmpeg) reopen the name: check it still names the
   // file we created, not a symlink or file swapped in meanwhile.
   struct stat st {};
-  if (::lstat(path_.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_dev != dev_ ||
-      st.st_ino != ino_)
+  auto ours = [&] { return S_ISREG(st.st_mode) && st.st_dev == dev_ && st.st_ino == ino_; };
+  if (::lstat(path_.c_str(), &st) != 0 || !ours())
     throw Error(subject_,
                 fmt::format("its temporary file '{}' was replaced while writing", echo(path_)));
+  // A writer that was given the descriptor has closed it: the file is opened again to sync it.
+  if (fd_ < 0) {
+    fd_ = ::open(path_.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd_ < 0 || ::fstat(fd_, &st) != 0 || !ours())
+      throw Error(subject_,
+                  fmt::format("its temporary file '{}' was replaced while writing", echo(path_)));
+  }
+  // Delayed allocation and network file systems report a full disk here, not at write().
+  if (::fsync(fd_) != 0) fail_unsaved(fmt::format("fsync: {}", std::strerror(errno)));
+  if (::fstat(fd_, &st) != 0) fail_unsaved(fmt::format("fstat: {}", std::strerror(errno)));
+  if (st.st_size == 0) fail_unsaved("the file is empty (disk full?)");
+  if (written_ > 0 && (unsigned long long)st.st_size != written_)
+    fail_unsaved(fmt::format("{} of {} bytes reached the disk", st.st_size, written_));
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) fail_unsaved(fmt::format("close: {}", std::strerror(errno)));
+  if (verify) {
+    verify(path_);
+    if (::lstat(path_.c_str(), &st) != 0 || !ours())
+      throw Error(subject_,
+                  fmt::format("its temporary file '{}' was replaced while writing", echo(path_)));
+  }
   if (::rename(path_.c_str(), target_.c_str()) != 0)
     throw Error(subject_,
                 fmt::format("cannot move the finished file into place ({})", std::strerror(errno)));
   committed_ = true;
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
 }
 
 bool is_temporary_name(const std::string& name, std::string* target_name) {

@@ -31,14 +31,22 @@ class TempFile {
   void write(const void* data, std::size_t size);
   // Gives the descriptor away (e.g. to fdopen); the file is still removed unless committed.
   int release_fd();
-  // Renames the finished temporary over the target (a symlink at the target is replaced, not
-  // followed). Throws emaki::Error(subject) when the temporary was swapped for another file.
-  void commit();
+  // Checks what reached the disk, then renames the finished temporary over the target (a symlink
+  // at the target is replaced, not followed). Before the rename: fsync and close must succeed,
+  // the file must not be empty, it must hold every byte write() took, and `verify` (given the
+  // temporary's path; a format's reader) must accept it. A writer that reports success while the
+  // disk took only part of the file (OpenEXR's last writes on a full disk) so never replaces the
+  // target. Throws emaki::Error(subject) when any check fails (the temporary is then removed) or
+  // when the temporary was swapped for another file.
+  void commit(const std::function<void(const std::string& path)>& verify = {});
 
  private:
+  [[noreturn]] void fail_unsaved(const std::string& why) const;
+
   std::string target_, subject_, path_;
   int fd_ = -1;
   unsigned long long dev_ = 0, ino_ = 0;
+  unsigned long long written_ = 0;  // bytes taken by write()
   bool committed_ = false;
 };
 

@@ -1,5 +1,6 @@
 #include "io/png_io.h"
 
+#include <fmt/format.h>
 #include <png.h>
 
 #include <algorithm>
@@ -219,6 +220,24 @@ AnyImage read_png_header(const std::string& path) {
   PngSource src;
   src.file = file.get();
   return decode(src, path, true);
+}
+
+void check_png_complete(const std::string& path, uint64_t size, const std::string& subject) {
+  std::unique_ptr<FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw Error(subject, "cannot open for reading");
+  PngSource src;
+  src.file = file.get();
+  decode(src, subject, true);
+  // The empty IEND chunk: its length, its type and its CRC.
+  static const unsigned char kEnd[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  unsigned char end[12] = {};
+  if (std::fseek(file.get(), 0, SEEK_END) != 0) throw Error(subject, "cannot read the file");
+  const long have = std::ftell(file.get());
+  if (have < 0 || (size != 0 && uint64_t(have) != size))
+    throw Error(subject, fmt::format("holds {} bytes, {} were written (disk full?)", have, size));
+  if (std::fseek(file.get(), -12, SEEK_END) != 0 || std::fread(end, 1, 12, file.get()) != 12 ||
+      !std::equal(end, end + 12, kEnd))
+    throw Error(subject, "PNG has no end chunk (the file is truncated)");
 }
 
 AnyImage read_png_memory(const void* data, std::size_t size, const std::string& name) {

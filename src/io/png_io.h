@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -29,11 +30,14 @@ AnyImage read_png_memory(const void* data, std::size_t size, const std::string& 
 // Only the header: channel names (R, G, B, A / Y, A) with an empty image.
 AnyImage read_png_header(const std::string& path);
 // Writes 8- or 16-bit PNG with 1-4 channels, values clamped to [0, 1]. `path` is written as is
-// (the caller makes it atomic).
-void write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
-               const std::string& error_subject);
+// (the caller makes it atomic). Returns the file's size in bytes.
+uint64_t write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
+                   const std::string& error_subject);
 // The same into an open file, which it closes (the caller created it, e.g. exclusively).
-void write_png(std::FILE* file, ImageView<const float> image, bool sixteen_bit,
-               const std::string& error_subject);
+uint64_t write_png(std::FILE* file, ImageView<const float> image, bool sixteen_bit,
+                   const std::string& error_subject);
+// Throws emaki::Error(subject) unless the file at `path` is a whole PNG as write_png makes one:
+// `size` bytes (when not 0), a header that reads, and the IEND chunk as its last 12 bytes.
+void check_png_complete(const std::string& path, uint64_t size, const std::string& subject);
 
 }  // namespace emaki::io::detail

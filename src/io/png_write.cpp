@@ -148,15 +148,15 @@ void write_chunk(std::FILE* f, const char type[4], const unsigned char* data, st
 
 }  // namespace
 
-void write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
-               const std::string& subject) {
+uint64_t write_png(const std::string& path, ImageView<const float> image, bool sixteen_bit,
+                   const std::string& subject) {
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) throw Error(subject, "cannot open for writing");
-  write_png(file, image, sixteen_bit, subject);
+  return write_png(file, image, sixteen_bit, subject);
 }
 
-void write_png(std::FILE* opened, ImageView<const float> image, bool sixteen_bit,
-               const std::string& subject) {
+uint64_t write_png(std::FILE* opened, ImageView<const float> image, bool sixteen_bit,
+                   const std::string& subject) {
   std::unique_ptr<FILE, FileCloser> file(opened);
   if (image.channels < 1 || image.channels > 4) throw Error(subject, "PNG takes 1 to 4 channels");
   if (image.width < 1 || image.height < 1) throw Error(subject, "PNG needs at least one pixel");
@@ -197,7 +197,11 @@ void write_png(std::FILE* opened, ImageView<const float> image, bool sixteen_bit
     write_chunk(file.get(), "IDAT", p.deflated.data(), p.deflated.size(), subject);
   }
   write_chunk(file.get(), "IEND", nullptr, 0, subject);
-  if (std::fflush(file.get()) != 0) throw Error(subject, "write failed (disk full?)");
+  const long bytes = std::ftell(file.get());
+  if (std::fflush(file.get()) != 0 || bytes < 0) throw Error(subject, "write failed (disk full?)");
+  // A close can report what the flush did not (a network file system's deferred error).
+  if (std::fclose(file.release()) != 0) throw Error(subject, "write failed on close (disk full?)");
+  return uint64_t(bytes);
 }
 
 }  // namespace emaki::io::detail

@@ -52,7 +52,7 @@ std::vector<std::string> write_previews(const Shot& shot, int first, int last) {
   // Frames composited under other settings (a killed run after a resize) are not previewed.
   const auto made =
       read_manifest((fs::path(shot.outputs.folder) / "composite" / kManifest).string());
-  if (!made || *made != frames_manifest(shot)) return written;
+  if (!made || !manifest_current(*made, frames_manifest(shot))) return written;
   for (int f = first; f <= last; ++f)
     if (!fs::is_regular_file(paths.composite_png(f), ec)) return written;  // not all composited
   if (shot.outputs.contact_sheet && shot.outputs.composite_png) {

@@ -2,11 +2,35 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <glm/glm.hpp>
+#include <set>
 
 namespace emaki::io {
 
+namespace fs = std::filesystem;
+
 namespace {
+
+// Where an input is, written for whoever reads the manifest (the comparison leaves it out: its
+// digest line says what the file is).
+std::string canonical(const std::string& path) {
+  std::error_code ec;
+  const fs::path c = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  return ec ? path : c.string();
+}
+
+// A frame pattern's folder made canonical (the pattern itself names no file).
+std::string canonical_pattern(const std::string& pattern) {
+  const fs::path p(pattern);
+  return (fs::path(canonical(p.parent_path().empty() ? "." : p.parent_path().string())) /
+          p.filename())
+      .string();
+}
+
+std::string key_of(const std::string& line) {
+  return line.substr(0, line.find(" = "));
+}
 
 std::string v2(const glm::vec2& v) {
   return fmt::format("{} {}", v.x, v.y);
@@ -31,7 +55,7 @@ void add_light(Lines& l, const std::string& p, const scene::LightSpec& s) {
 
 void add_object(Lines& l, std::size_t i, const pipeline::SceneObject& o) {
   const std::string p = fmt::format("source.objects[{}]", i);
-  l.add(p + ".scene", o.scene);
+  l.add(p + ".scene", canonical(o.scene));
   l.add(p + ".scene.digest", file_digest(o.scene));
   l.add(p, fmt::format("translate {} rotate {} scale {} velocity {} clip {} start {} loop {} id {}",
                        v3(o.translate), v3(o.rotate_deg), v3(o.scale), v3(o.velocity), o.clip,
@@ -46,7 +70,7 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
   l.add("source.first_frame", s.first_frame);
   if (s.kind == pipeline::SourceKind::kScene) {
     if (s.objects.empty()) {
-      l.add("source.scene", s.scene_path);
+      l.add("source.scene", canonical(s.scene_path));
       l.add("source.scene.digest", file_digest(s.scene_path));
     }
     for (std::size_t i = 0; i < s.objects.size(); ++i) add_object(l, i, s.objects[i]);
@@ -71,7 +95,7 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
                       r.outline_width, r.crease_deg, r.depth_jump, r.shadow_map_size));
   } else {
     // A sequence's frames are not hashed (they may be gigabytes): its pattern and conventions.
-    l.add("source.sequence", s.pattern);
+    l.add("source.sequence", canonical_pattern(s.pattern));
     l.add("source.preset",
           fmt::format("{} {} world_normals {} z_up {} premultiplied {}",
                       s.preset == pipeline::SourcePreset::kBlender ? "blender" : "emaki",
@@ -84,7 +108,7 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
 void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
   const std::string p = "exemplars." + e.name + ".";
   l.add(p + "kind", int(e.kind));
-  l.add(p + "painting", e.painting);
+  l.add(p + "painting", canonical(e.painting));
   l.add(p + "painting.digest", file_digest(e.painting));
   if (e.kind == pipeline::ExemplarKind::kMatcap) {
     const exemplar::ReferenceSpec& r = e.reference;
@@ -95,7 +119,7 @@ void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
                       v3(r.ground_color), v3(r.background), e.aa));
     add_light(l, p + "light.", r.light);
   } else {
-    l.add(p + "passes", e.passes);
+    l.add(p + "passes", canonical(e.passes));
     l.add(p + "passes.digest", file_digest(e.passes));
   }
 }
@@ -113,7 +137,7 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
     l.add(p + "guides." + g.pass, g.weight);
     if (!g.map_pass.empty()) l.add(p + "guides." + g.pass + ".map", "pass " + g.map_pass);
     if (!g.map_image.empty()) {
-      l.add(p + "guides." + g.pass + ".map", g.map_image);
+      l.add(p + "guides." + g.pass + ".map", canonical(g.map_image));
       l.add(p + "guides." + g.pass + ".map.digest", file_digest(g.map_image));
     }
   }
@@ -154,6 +178,40 @@ Manifest frames_manifest(const pipeline::Shot& shot) {
   for (const pipeline::Layer& layer : shot.layers)
     l.add("layers." + layer.name + ".single_colour", layer.single_colour);
   return l.m;
+}
+
+namespace {
+
+// The lines manifest_current compares: path lines with a digest beside them dropped, a
+// sequence's pattern made canonical (older manifests spelled it as the command line did).
+Manifest comparable(const Manifest& m) {
+  std::set<std::string> digested;
+  for (const std::string& line : m) {
+    const std::string key = key_of(line);
+    constexpr std::string_view kDigest = ".digest";
+    if (key.size() > kDigest.size() && key.ends_with(kDigest))
+      digested.insert(key.substr(0, key.size() - kDigest.size()));
+  }
+  Manifest out;
+  for (const std::string& line : m) {
+    const std::string key = key_of(line);
+    if (digested.count(key)) continue;
+    if (key == "source.sequence" && line.size() > key.size() + 3)
+      out.push_back(key + " = " + canonical_pattern(line.substr(key.size() + 3)));
+    else
+      out.push_back(line);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool manifest_current(const Manifest& have, const Manifest& want) {
+  return comparable(have) == comparable(want);
+}
+
+std::string manifest_change(const Manifest& have, const Manifest& want) {
+  return manifest_difference(comparable(have), comparable(want));
 }
 
 }  // namespace emaki::io

@@ -18,4 +18,15 @@ Manifest frames_manifest(const pipeline::Shot& shot);
 // The guide passes of a scene source's frames (the farm's pass cache, passes/frame_%04d.exr).
 Manifest passes_manifest(const pipeline::Shot& shot);
 
+// Whether files made under the manifest `have` (read from disk) are current for `want`. Inputs
+// are told apart by what they are, never by how a path to them was spelled: an input file's path
+// line is left out of the comparison wherever a `KEY.digest` line beside it holds the file's
+// content digest, and a sequence's pattern is compared as a canonical path (symbolic links
+// resolved). `emaki run shot.toml`, `emaki run $PWD/shot.toml`, a path through a linked folder
+// and a farm's absolute paths so all find the same outputs current.
+bool manifest_current(const Manifest& have, const Manifest& want);
+// What changed from `have` to `want` (manifest_difference on what manifest_current compares);
+// empty when current.
+std::string manifest_change(const Manifest& have, const Manifest& want);
+
 }  // namespace emaki::io

@@ -89,7 +89,8 @@ FrameGeometry build_geometry(const scene::Scene& scene, const scene::PosedScene&
 }
 
 glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv) {
-  const int w = t.rgba.width(), h = t.rgba.height();
+  const Image<float>& rgba = *t.rgba;
+  const int w = rgba.width(), h = rgba.height();
   // A non-finite uv (from a degenerate triangle's barycentrics) reads texel 0: converting it to
   // int would be undefined.
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
@@ -100,7 +101,7 @@ glm::vec4 sample_texture(const scene::Texture& t, glm::vec2 uv) {
   auto texel = [&](int xi, int yi) {
     xi = t.wrap_s == scene::Texture::Wrap::kRepeat ? ((xi % w) + w) % w : std::clamp(xi, 0, w - 1);
     yi = t.wrap_t == scene::Texture::Wrap::kRepeat ? ((yi % h) + h) % h : std::clamp(yi, 0, h - 1);
-    const float* p = t.rgba.at(xi, yi);
+    const float* p = rgba.at(xi, yi);
     return glm::vec4(p[0], p[1], p[2], p[3]);
   };
   return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <map>
 
 #include "core/check.h"
 
@@ -25,10 +26,10 @@ struct Offsets {
   int node, mesh, material, texture, skin, camera;
 };
 
-// The asset's materials, textures, meshes, skins and cameras appended to `out`. A primitive
-// without a material gets the asset's own white default, so no two assets share a material id.
+// The asset's materials, meshes, skins and cameras appended to `out` (its textures are already
+// there, from `o.texture` on: shared by every placement of the asset). A primitive without a
+// material gets the asset's own white default, so no two assets share a material id.
 void append_data(const Scene& a, const Offsets& o, Scene& out) {
-  for (const Texture& t : a.textures) out.textures.push_back({t.rgba.clone(), t.wrap_s, t.wrap_t});
   for (Material m : a.materials) {
     m.base_color_texture = shifted(m.base_color_texture, o.texture);
     out.materials.push_back(m);
@@ -154,11 +155,17 @@ Scene assemble(std::span<const Placement> objects) {
   clip.name = kAssemblyClip;
   clip.start = 0.0f;
   clip.end = kAssemblyClipEnd;
+  // Where each asset's textures start: an asset placed many times (a crowd of one character)
+  // holds its textures once, shared, however many placements draw them.
+  std::map<const Scene*, int> textures_at;
   for (const Placement& p : objects) {
     CHECK(p.asset != nullptr);
     const Scene& a = *p.asset;
-    const Offsets o{int(out.nodes.size()),    int(out.meshes.size()), int(out.materials.size()),
-                    int(out.textures.size()), int(out.skins.size()),  int(out.cameras.size())};
+    const auto [at, first] = textures_at.try_emplace(&a, int(out.textures.size()));
+    if (first) out.textures.insert(out.textures.end(), a.textures.begin(), a.textures.end());
+    const Offsets o{int(out.nodes.size()),     int(out.meshes.size()),
+                    int(out.materials.size()), at->second,
+                    int(out.skins.size()),     int(out.cameras.size())};
     append_data(a, o, out);
     append_nodes(a, o, p.object_id, out);
     set_rest_positions(a, o, out);

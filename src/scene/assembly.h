@@ -34,7 +34,8 @@ struct Placement {
 // translate * rotate * scale: where the asset stands at time 0.
 glm::mat4 placement_matrix(const Placement& p);
 
-// The objects in one scene. Each asset's rest positions
+// The objects in one scene. An asset placed several times shares its textures between its
+// placements (its meshes are copied per placement). Each asset's rest positions
 // (Primitive::rest_positions) are its rest pose — posed node transforms, bind pose for skinned
 // meshes — in the unit cube around it, so the rest_position pass of a small prop keeps the
 // precision of a large one; a mesh that an asset draws from several nodes is copied per node.

@@ -5,12 +5,39 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <set>
 
 #include "core/check.h"
 #include "core/error.h"
 #include "core/limits.h"
 
 namespace emaki::scene {
+
+namespace {
+
+template <typename T>
+int64_t bytes_of(const std::vector<T>& v) {
+  return int64_t(v.size()) * int64_t(sizeof(T));
+}
+
+}  // namespace
+
+int64_t primitive_bytes(const Primitive& p) {
+  int64_t n = bytes_of(p.positions) + bytes_of(p.normals) + bytes_of(p.uvs) + bytes_of(p.joints) +
+              bytes_of(p.weights) + bytes_of(p.indices) + bytes_of(p.rest_positions);
+  for (const MorphTarget& t : p.targets) n += bytes_of(t.positions) + bytes_of(t.normals);
+  return n;
+}
+
+SceneBytes scene_bytes(const Scene& scene) {
+  SceneBytes b;
+  std::set<const Image<float>*> seen;
+  for (const Texture& t : scene.textures)
+    if (t.rgba && seen.insert(t.rgba.get()).second) b.textures += int64_t(t.rgba->bytes());
+  for (const Mesh& m : scene.meshes)
+    for (const Primitive& p : m.primitives) b.geometry += primitive_bytes(p);
+  return b;
+}
 
 int Scene::find_animation(const std::string& name) const {
   for (int i = 0; i < int(animations.size()); ++i)

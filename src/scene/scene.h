@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,9 +15,11 @@
 namespace emaki::scene {
 
 // A decoded texture: linear-light RGBA float (sRGB-encoded colour textures are decoded on load).
+// Shared and immutable: an assembly (scene/assembly.h) that places one asset many times holds
+// its textures once.
 struct Texture {
   enum class Wrap { kRepeat, kClamp, kMirror };
-  Image<float> rgba;  // 4 channels
+  std::shared_ptr<const Image<float>> rgba;  // 4 channels, never null
   Wrap wrap_s = Wrap::kRepeat;
   Wrap wrap_t = Wrap::kRepeat;
 };
@@ -139,6 +142,17 @@ struct Scene {
   // Index of the clip called `name`, or -1.
   int find_animation(const std::string& name) const;
 };
+
+// What a scene holds in memory: its decoded textures (each shared image counted once) and its
+// geometry (every mesh's vertex, index and morph arrays). The figure a scene budget is charged.
+struct SceneBytes {
+  int64_t textures = 0;
+  int64_t geometry = 0;
+  int64_t total() const { return textures + geometry; }
+};
+SceneBytes scene_bytes(const Scene& scene);
+// Geometry bytes of one mesh primitive.
+int64_t primitive_bytes(const Primitive& p);
 
 // Samples one animation sampler at time t (clamped to its key range) into out[components].
 // Rotations (components == 4 with slerp) are normalised quaternions stored x, y, z, w.

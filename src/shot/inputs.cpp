@@ -8,7 +8,6 @@
 #include "core/limits.h"
 #include "io/file_store.h"
 #include "io/frame_sequence.h"
-#include "io/gltf_loader.h"
 #include "io/image_io.h"
 #include "shot/objects.h"
 
@@ -78,9 +77,7 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
   const pipeline::Source& s = shot.source;
   try {
     if (s.kind == pipeline::SourceKind::kSequence) return io::open_sequence(s);
-    if (!s.objects.empty())
-      return io::with_pass_cache(shot, pipeline::scene_frames(load_objects(s), s));
-    return io::with_pass_cache(shot, pipeline::scene_frames(io::load_gltf(s.scene_path), s));
+    return io::with_pass_cache(shot, pipeline::scene_frames(load_scene(s), s));
   } catch (const Error& e) {
     rethrow_as_key(e, "source");
   }

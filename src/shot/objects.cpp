@@ -1,10 +1,15 @@
 #include "shot/objects.h"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -19,18 +24,53 @@ std::string key_of(std::size_t i, const char* key) {
   return fmt::format("source.objects[{}].{}", i, key);
 }
 
-// Vertices the asset draws (a mesh drawn by two nodes counts twice), as the loader counts them.
-int64_t drawn_vertices(const scene::Scene& s) {
-  int64_t n = 0;
-  std::vector<int> stack = s.roots;
+// What a placement of `asset` adds to the assembled scene (scene::assemble): a copy of every
+// mesh, another for each further node that draws one, and rest positions for what is drawn; and
+// what it draws (a mesh drawn by two nodes counts twice, as the loader counts them).
+SceneCost placement_cost(const scene::Scene& asset) {
+  SceneCost c;
+  std::vector<int64_t> mesh_bytes;
+  for (const scene::Mesh& m : asset.meshes) {
+    int64_t b = 0;
+    for (const scene::Primitive& p : m.primitives) b += scene::primitive_bytes(p);
+    mesh_bytes.push_back(b);
+    c.bytes += b;
+  }
+  std::vector<char> drawn(asset.meshes.size(), 0);
+  std::vector<int> stack = asset.roots;
   while (!stack.empty()) {
-    const scene::Node& node = s.nodes[stack.back()];
+    const scene::Node& node = asset.nodes[stack.back()];
     stack.pop_back();
-    if (node.mesh >= 0)
-      for (const scene::Primitive& p : s.meshes[node.mesh].primitives) n += p.positions.size();
+    if (node.mesh >= 0) {
+      if (drawn[node.mesh]) c.bytes += mesh_bytes[node.mesh];
+      drawn[node.mesh] = 1;
+      for (const scene::Primitive& p : asset.meshes[node.mesh].primitives) {
+        c.drawn_vertices += int64_t(p.positions.size());
+        c.drawn_triangles += int64_t(p.indices.size() / 3);
+        c.bytes += int64_t(p.positions.size() * sizeof(glm::vec3));  // rest positions
+      }
+    }
     stack.insert(stack.end(), node.children.begin(), node.children.end());
   }
-  return n;
+  return c;
+}
+
+std::string megabytes(int64_t bytes) {
+  return fmt::format("{:.0f} MB", double(bytes) / 1e6);
+}
+
+void check_budget(int64_t bytes, int64_t budget, const std::string& key, const char* what) {
+  if (bytes > budget)
+    throw Error(key, fmt::format("{} {} of textures and geometry; a shot's scene holds at most {}",
+                                 what, megabytes(bytes), megabytes(budget)));
+}
+
+// A file's identity on disk: its device and inode.
+std::pair<uint64_t, uint64_t> file_identity(const std::string& path, const std::string& key) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0)
+    throw Error(key, fmt::format("cannot open '{}' ({})", echo_path(path), std::strerror(errno)));
+  return {uint64_t(st.st_dev), uint64_t(st.st_ino)};
 }
 
 // The object's clip (-1: none in the file), checked as the renderer checks a scene's: the start
@@ -62,23 +102,31 @@ int find_clip(const scene::Scene& asset, const pipeline::SceneObject& o, std::si
 
 }  // namespace
 
-scene::Scene load_objects(const pipeline::Source& s) {
-  std::map<std::string, std::unique_ptr<scene::Scene>> assets;
+scene::Scene load_objects(const pipeline::Source& s, SceneCost* cost, int64_t budget) {
+  std::map<std::pair<uint64_t, uint64_t>, std::unique_ptr<scene::Scene>> assets;
   std::vector<scene::Placement> placements;
-  int64_t vertices = 0;
+  SceneCost total;
   for (std::size_t i = 0; i < s.objects.size(); ++i) {
     const pipeline::SceneObject& o = s.objects[i];
-    std::unique_ptr<scene::Scene>& asset = assets[o.scene];
-    try {
-      if (!asset) asset = std::make_unique<scene::Scene>(io::load_gltf(o.scene));
-    } catch (const Error& e) {
-      throw Error(key_of(i, "scene"), e.what());
+    const std::string key = key_of(i, "scene");
+    std::unique_ptr<scene::Scene>& asset = assets[file_identity(o.scene, key)];
+    if (!asset) {
+      try {
+        asset = std::make_unique<scene::Scene>(io::load_gltf(o.scene));
+      } catch (const Error& e) {
+        throw Error(key, e.what());
+      }
+      total.bytes += scene::scene_bytes(*asset).total();
+      check_budget(total.bytes, budget, key, "the objects' files so far hold");
     }
-    vertices += drawn_vertices(*asset);
-    if (vertices > io::kMaxVertices)
-      throw Error(key_of(i, "scene"),
-                  fmt::format("the objects so far draw {} vertices; a shot draws at most {}",
-                              vertices, io::kMaxVertices));
+    const SceneCost placed = placement_cost(*asset);
+    total.drawn_vertices += placed.drawn_vertices;
+    total.drawn_triangles += placed.drawn_triangles;
+    if (total.drawn_vertices > io::kMaxVertices)
+      throw Error(key, fmt::format("the objects so far draw {} vertices; a shot draws at most {}",
+                                   total.drawn_vertices, io::kMaxVertices));
+    total.bytes += placed.bytes;
+    check_budget(total.bytes, budget, key, "with this object, the scene would hold");
     scene::Placement p;
     p.asset = asset.get();
     p.translate = o.translate;
@@ -94,6 +142,17 @@ scene::Scene load_objects(const pipeline::Source& s) {
   }
   scene::Scene out = scene::assemble(placements);
   out.source = "source.objects";
+  if (cost) *cost = total;
+  return out;
+}
+
+scene::Scene load_scene(const pipeline::Source& s, SceneCost* cost) {
+  if (!s.objects.empty()) return load_objects(s, cost);
+  scene::Scene out = io::load_gltf(s.scene_path);
+  SceneCost c = placement_cost(out);
+  c.bytes = scene::scene_bytes(out).total();
+  check_budget(c.bytes, kMaxSceneBytes, "source.scene", "the scene holds");
+  if (cost) *cost = c;
   return out;
 }
 

@@ -1,12 +1,17 @@
 // source.objects: parsed with their defaults and key-path errors, opened into one scene whose
 // passes carry each object's id, and written into the manifests that resuming trusts.
-#include <gtest/gtest.h>
+#include "shot/objects.h"
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
 #include <map>
 #include <set>
 #include <string>
 
 #include "core/error.h"
+#include "io/gltf_loader.h"
 #include "io/shot_manifest.h"
 #include "render/passes.h"
 #include "scene/assembly.h"
@@ -126,6 +131,71 @@ TEST(Objects, ManifestsHoldTheObjects) {
   EXPECT_NE(ma, io::layer_manifest(b, b.layers[0]));
   EXPECT_NE(ma, io::layer_manifest(c, c.layers[0]));
   EXPECT_EQ(ma, io::layer_manifest(a, a.layers[0]));
+}
+
+// ---- one file, one load; one budget over the scene ----
+
+// A folder with a link to Fox.glb and a link to the folder holding it: four spellings of one file.
+class SharedAssets : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("emaki_objects_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    std::filesystem::create_symlink(kData + "/scenes/Fox.glb", dir_ / "fox_link.glb");
+    std::filesystem::create_directory_symlink(kData + "/scenes", dir_ / "scenes_link");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // `n` Fox objects, their paths cycling through the four spellings.
+  pipeline::Shot foxes(int n) const {
+    const std::string spellings[4] = {kData + "/scenes/Fox.glb", (dir_ / "fox_link.glb").string(),
+                                      (dir_ / "scenes_link/Fox.glb").string(),
+                                      kData + "/scenes/../scenes/Fox.glb"};
+    std::string objects;
+    for (int i = 0; i < n; ++i)
+      objects += "[[source.objects]]\nscene = \"" + spellings[i % 4] +
+                 "\"\nclip = \"Walk\"\nloop = true\nscale = 0.01\n";
+    return open_text(shot_text(objects), (dir_ / "shot.toml").string());
+  }
+
+  std::filesystem::path dir_;
+};
+
+// 256 objects of one file through four spellings of its path: one load, one texture, each
+// placement's geometry copied. Before, each spelling was loaded and every placement cloned the
+// texture (256 of them).
+TEST_F(SharedAssets, OneFileIsLoadedOnceAndItsTexturesAreShared) {
+  const scene::Scene fox = io::load_gltf(kData + "/scenes/Fox.glb");
+  const scene::SceneBytes one = scene::scene_bytes(fox);
+  ASSERT_EQ(fox.textures.size(), 1u);
+  SceneCost cost;
+  const scene::Scene s = load_objects(foxes(256).source, &cost);
+  EXPECT_EQ(s.textures.size(), 1u);
+  const scene::SceneBytes all = scene::scene_bytes(s);
+  EXPECT_EQ(all.textures, one.textures);
+  EXPECT_GT(all.geometry, 256 * one.geometry);
+  // What was charged: the file once (textures and geometry) and every placement's copy.
+  EXPECT_EQ(cost.bytes, all.total() + one.geometry);
+  EXPECT_EQ(cost.drawn_vertices, 256 * int64_t(fox.meshes[0].primitives[0].positions.size()));
+}
+
+// Over the budget, the object that takes the scene over it is named, before its copy is made.
+TEST_F(SharedAssets, ASceneOverItsBudgetNamesTheObjectThatTakesItOver) {
+  SceneCost two;
+  load_objects(foxes(2).source, &two);
+  SceneCost three;
+  load_objects(foxes(3).source, &three);
+  try {
+    load_objects(foxes(8).source, nullptr, (two.bytes + three.bytes) / 2);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.subject(), "source.objects[2].scene") << e.what();
+    EXPECT_NE(std::string(e.what()).find("at most"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "core/utf8.h"
 #include "io/file_store.h"
 #include "io/image_io.h"
+#include "shot/objects.h"
 #include "shot/shot.h"
 
 namespace emaki::shot {
@@ -36,10 +37,36 @@ const char* task_kind_name(TaskKind kind) {
 
 namespace {
 
-// Peak resident memory of a task in MB, from the frame size and the exemplars' sizes. The
-// constants are peak RSS per pixel measured with /usr/bin/time on `emaki task` at 160x90,
+// What a task holds of a scene source: the opened scene (shot/objects.h) in every task that
+// opens it, and, in the passes task that renders it, the posed geometry of a frame (about 250
+// bytes a drawn vertex and 200 a drawn triangle, io/gltf_loader.h).
+double scene_mb(const SceneCost& scene, TaskKind kind) {
+  if (kind == TaskKind::kPreviews) return 0;
+  double bytes = double(scene.bytes);
+  if (kind == TaskKind::kPasses)
+    bytes += 250.0 * double(scene.drawn_vertices) + 200.0 * double(scene.drawn_triangles);
+  return bytes / 1e6;
+}
+
+// The scene opened as every task opens it. One that does not open (a broken file, a scene over
+// its budget) costs nothing here: the shot's prepare task fails on it with the error, and the
+// other shots of the plan still run.
+SceneCost scene_cost(const pipeline::Shot& s) {
+  SceneCost cost;
+  if (s.source.kind != pipeline::SourceKind::kScene) return cost;
+  try {
+    (void)load_scene(s.source, &cost);
+  } catch (const Error&) {
+    return {};
+  }
+  return cost;
+}
+
+// Peak resident memory of a task in MB, from the frame size, the exemplars' sizes and the scene.
+// The constants are peak RSS per pixel measured with /usr/bin/time on `emaki task` at 160x90,
 // 480x270 and 960x540 with the StyLit exemplar (docs/farm.md), plus a quarter for margin.
-int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind) {
+int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, const SceneCost& scene,
+                        TaskKind kind) {
   const double px = double(s.source.width) * s.source.height;
   const double aa = s.source.kind == pipeline::SourceKind::kScene ? s.source.render.aa : 1;
   double mb = 0;
@@ -60,6 +87,7 @@ int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, TaskKin
       mb = 60 + px * 60 / 1e6;
       break;
   }
+  mb += scene_mb(scene, kind);
   const int64_t with_margin = int64_t(mb * 1.25) + 1;
   return (with_margin + 63) / 64 * 64;
 }
@@ -103,6 +131,7 @@ class Planner {
     const int first = s.source.first_frame, last = s.source.last_frame;
     exemplar_pixels_ = exemplar_pixels(s);
     shot_tasks_ = plan_.tasks.size();
+    scene_ = scene_cost(s);
 
     const bool scene = s.source.kind == pipeline::SourceKind::kScene;
     // Each task is done when its own outputs are there under current manifests (what `emaki run`
@@ -207,7 +236,7 @@ class Planner {
     t.threads = o_.threads;
     t.argv.insert(t.argv.end(), {"--threads", std::to_string(o_.threads)});
     t.outputs = std::move(outputs);
-    t.memory_mb = memory_estimate(ps.shot, exemplar_pixels_, kind);
+    t.memory_mb = memory_estimate(ps.shot, exemplar_pixels_, scene_, kind);
     t.done = done;
     for (const std::string& id : after)
       if (!done_.at(id)) t.after.push_back(id);
@@ -221,6 +250,7 @@ class Planner {
   double exemplar_pixels_ = 0;
   std::size_t shot_tasks_ = 0;                  // the current shot's first task
   std::unordered_map<std::string, bool> done_;  // task id -> done
+  SceneCost scene_;
 };
 
 }  // namespace

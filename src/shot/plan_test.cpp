@@ -11,8 +11,10 @@
 
 #include "core/error.h"
 #include "core/utf8.h"
+#include "shot/objects.h"
 #include "shot/shot.h"
 #include "tests/small_painting.h"
+#include "tests/textured_triangle.h"
 
 namespace emaki::shot {
 namespace {
@@ -207,5 +209,39 @@ TEST_F(PlanTest, FarmTasksNeedAPreparedFolder) {
   EXPECT_EQ(run(s.shot, r).report.synthesized, 2);
 }
 
+// A crowd of objects costs what its scene holds: the tasks that open it are estimated with it,
+// the passes task also with the geometry it poses per frame. Here 256 objects of one triangle
+// with a 2048 x 2048 texture (64 MiB as float RGBA), half of them through a link to the file;
+// before, the estimate left the scene out (256 Fox objects peaked at 4.5 GB under 256 MB).
+TEST_F(PlanTest, MemoryEstimatesCountTheScene) {
+  const std::string tri = test::write_textured_triangle(dir_, 2048);
+  fs::create_symlink(tri, dir_ / "link.gltf");
+  std::string objects;
+  for (int i = 0; i < 256; ++i)
+    objects +=
+        "[[source.objects]]\nscene = \"" + (i % 2 ? tri : (dir_ / "link.gltf").string()) + "\"\n";
+  const std::string text = "[source]\nframes = [0, 1]\nsize = [32, 20]\naa = 1\n" + objects +
+                           "[exemplars.sphere]\npainting = \"" + painting() +
+                           "\"\n[layers.ink]\nkind = \"outline\"\nexemplar = \"sphere\"\n" +
+                           "[outputs]\nfolder = \"" + (dir_ / "crowd").string() +
+                           "\"\nmp4 = false\n";
+  const std::string path = (dir_ / "crowd.toml").string();
+  const PlannedShot crowd{"", path, open_text(text, path)};
+  // The same shot with one Fox (its scene under a megabyte) as the measure of the rest.
+  PlannedShot fox = shot("fox", 1);
+  const Plan p = plan(std::vector<PlannedShot>{crowd, fox}, PlanOptions{});
+  SceneCost cost;
+  load_scene(crowd.shot.source, &cost);
+  const double opened_mb = double(cost.bytes) / 1e6;
+  ASSERT_GT(opened_mb, 64.0);
+  ASSERT_LT(opened_mb, 80.0);  // the texture once
+  // Estimates are rounded up to 64 MB and carry a quarter of margin.
+  for (const char* kind : {"prepare", "composite.0-1", "passes.0-1"}) {
+    const double more = double(task(p, std::string("crowd.") + kind).memory_mb -
+                               task(p, std::string("fox.") + kind).memory_mb);
+    EXPECT_GE(more, 1.25 * opened_mb - 64 - 2) << kind;
+  }
+  EXPECT_EQ(task(p, "crowd.previews").memory_mb, task(p, "fox.previews").memory_mb);
+}
 }  // namespace
 }  // namespace emaki::shot
