@@ -13,8 +13,8 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "farm/process.h"
-#include "io/file_store.h"
-#include "io/output_store.h"
+#include "store/file_store.h"
+#include "store/output_store.h"
 
 namespace emaki::farm {
 

@@ -7,11 +7,11 @@
 #include <string>
 
 #include "core/error.h"
-#include "io/shot_manifest.h"
 #include "render/passes.h"
 #include "scene/assembly.h"
 #include "shot/inputs.h"
 #include "shot/shot.h"
+#include "store/shot_manifest.h"
 
 namespace emaki::shot {
 namespace {

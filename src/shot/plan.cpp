@@ -8,9 +8,9 @@
 
 #include "core/error.h"
 #include "core/limits.h"
-#include "io/file_store.h"
 #include "io/image_io.h"
 #include "shot/shot.h"
+#include "store/file_store.h"
 
 namespace emaki::shot {
 
