@@ -1,4 +1,4 @@
-// libFuzzer target: the reader of a temporal layer's warm-start field file (io/field_file.h),
+// libFuzzer target: the reader of a temporal layer's warm-start field file (store/field_file.h),
 // from bytes. An empty field is the expected answer to a bad file; a crash, a sanitizer report,
 // a leak, more than 2 GB or 30 s on one input is a bug. The size the reader expects is taken
 // from the input's own header when it is small (so that inputs reach the zlib stream), else a
@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "io/field_file.h"
+#include "store/field_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   emaki::io::FieldKey want{7, 16, 12, 0x1234};

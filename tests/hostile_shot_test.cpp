@@ -15,11 +15,11 @@
 #include "cli_run.h"
 #include "core/error.h"
 #include "core/image.h"
-#include "io/frame_sequence.h"
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "shot/inputs.h"
 #include "shot/shot.h"
+#include "store/frame_sequence.h"
 
 namespace fs = std::filesystem;
 using emaki::test::CliResult;

@@ -19,9 +19,9 @@
 #include <thread>
 
 #include "core/image.h"
-#include "io/field_file.h"
-#include "io/file_store.h"
 #include "io/image_io.h"
+#include "store/field_file.h"
+#include "store/file_store.h"
 #include "tests/small_painting.h"
 
 extern char** environ;

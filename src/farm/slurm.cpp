@@ -19,8 +19,8 @@
 #include "farm/farm_state.h"
 #include "farm/process.h"
 #include "farm/script_text.h"
-#include "io/file_store.h"
-#include "io/output_store.h"
+#include "store/file_store.h"
+#include "store/output_store.h"
 
 namespace emaki::farm {
 

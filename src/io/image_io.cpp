@@ -15,9 +15,9 @@
 #include "core/limits.h"
 #include "io/exr_header.h"
 #include "io/oiio_backend.h"
-#include "io/output_store.h"
 #include "io/png_io.h"
 #include "io/read_limits.h"
+#include "io/temp_file.h"
 
 namespace emaki::io {
 namespace fs = std::filesystem;

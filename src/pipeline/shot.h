@@ -23,7 +23,7 @@ enum class SourceKind {
 // How a sequence's channels are named and what they mean.
 enum class SourcePreset {
   kEmaki,    // emaki's names and conventions, as `emaki render` and the Blender exporter write
-  kBlender,  // a plain Cycles render, converted (io/studio_passes.h)
+  kBlender,  // a plain Cycles render, converted (store/studio_passes.h)
 };
 
 // One pass of passes.h read from a studio render's channels.

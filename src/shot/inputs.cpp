@@ -6,10 +6,11 @@
 
 #include "core/error.h"
 #include "core/limits.h"
-#include "io/file_store.h"
-#include "io/frame_sequence.h"
+#include "io/gltf_loader.h"
 #include "io/image_io.h"
 #include "shot/objects.h"
+#include "store/file_store.h"
+#include "store/frame_sequence.h"
 
 namespace emaki::shot {
 

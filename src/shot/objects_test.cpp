@@ -12,11 +12,11 @@
 
 #include "core/error.h"
 #include "io/gltf_loader.h"
-#include "io/shot_manifest.h"
 #include "render/passes.h"
 #include "scene/assembly.h"
 #include "shot/inputs.h"
 #include "shot/shot.h"
+#include "store/shot_manifest.h"
 
 namespace emaki::shot {
 namespace {

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <filesystem>
 
-#include "io/frame_sequence.h"
 #include "io/image_io.h"
-#include "io/studio_passes.h"
 #include "render/passes.h"
 #include "shot/parse.h"
+#include "store/frame_sequence.h"
+#include "store/studio_passes.h"
 
 namespace emaki::shot {
 

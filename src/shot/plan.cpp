@@ -10,10 +10,10 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/utf8.h"
-#include "io/file_store.h"
 #include "io/image_io.h"
 #include "shot/objects.h"
 #include "shot/shot.h"
+#include "store/file_store.h"
 
 namespace emaki::shot {
 

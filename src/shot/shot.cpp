@@ -5,10 +5,10 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
-#include "io/file_store.h"
-#include "io/previews.h"
 #include "shot/inputs.h"
 #include "shot/shot_file.h"
+#include "store/file_store.h"
+#include "store/previews.h"
 
 namespace emaki::shot {
 

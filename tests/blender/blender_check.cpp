@@ -25,9 +25,9 @@
 #include <vector>
 
 #include "core/error.h"
-#include "io/frame_sequence.h"
 #include "io/image_io.h"
 #include "render/passes.h"
+#include "store/frame_sequence.h"
 
 namespace {
 

@@ -13,7 +13,8 @@
 
 #include "core/error.h"
 #include "io/image_io.h"
-#include "io/output_store.h"
+#include "io/temp_file.h"
+#include "store/output_store.h"
 #include "tests/small_disk.h"
 
 namespace fs = std::filesystem;

@@ -1,5 +1,5 @@
 // A studio render as the shot's frames: one multilayer EXR per frame, named by a printf-style
-// pattern, its channels read by the source's preset and mapping (io/studio_passes.h).
+// pattern, its channels read by the source's preset and mapping (store/studio_passes.h).
 #pragma once
 
 #include <memory>

@@ -1,14 +1,11 @@
 // Safe writes into folders other people can see: temporaries with unpredictable names created
-// exclusively (never through a planted symlink), a clean-up that removes only emaki's own
-// temporaries, a lock that keeps two emaki processes out of one output folder, and small
-// manifests (the settings that made an output) so that resuming never trusts stale files.
+// exclusively (never through a planted symlink), renamed over their target when finished, and a
+// clean-up that removes only emaki's own temporaries.
 #pragma once
 
 #include <cstddef>
 #include <functional>
-#include <optional>
 #include <string>
-#include <vector>
 
 namespace emaki::io {
 
@@ -61,36 +58,5 @@ void remove_temporaries(const std::string& dir,
 
 // 64 random bits from getrandom(2).
 unsigned long long random_u64();
-
-// An exclusive flock on "<folder>/.emaki.lock", held until destruction. The file holds the
-// holder's pid, host and start time (informational only: the kernel drops the lock when the
-// process dies, so a killed run never blocks the next one).
-class FolderLock {
- public:
-  // kShared: the tasks of one shot on a render farm, which write disjoint files and may run at
-  // once; an exclusive holder (emaki run) and shared holders exclude each other.
-  enum class Kind { kExclusive, kShared };
-  // Throws emaki::Error(lock file) naming the holder when another process holds it.
-  explicit FolderLock(const std::string& folder, Kind kind = Kind::kExclusive);
-  ~FolderLock();
-  FolderLock(const FolderLock&) = delete;
-  FolderLock& operator=(const FolderLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
-
-// A manifest: "key = value" lines, compared line by line.
-using Manifest = std::vector<std::string>;
-
-// nullopt when the file does not exist (or is not a regular file).
-std::optional<Manifest> read_manifest(const std::string& path);
-// Atomic (TempFile + rename).
-void write_manifest(const std::string& path, const Manifest& m);
-// The first line of `want` that `have` lacks or changes, as "key: was X, now Y"; empty when equal.
-std::string manifest_difference(const Manifest& have, const Manifest& want);
-
-// A 64-bit digest of a file's bytes as 16 hex digits; "missing" when it cannot be read.
-std::string file_digest(const std::string& path);
 
 }  // namespace emaki::io

@@ -1,4 +1,4 @@
-#include "io/field_file.h"
+#include "store/field_file.h"
 
 #include <zlib.h>
 

@@ -1,4 +1,4 @@
-#include "io/file_store.h"
+#include "store/file_store.h"
 
 #include <fmt/format.h>
 
@@ -11,10 +11,10 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
-#include "io/field_file.h"
 #include "io/image_io.h"
-#include "io/shot_manifest.h"
 #include "render/passes.h"
+#include "store/field_file.h"
+#include "store/shot_manifest.h"
 
 namespace emaki::io {
 

@@ -1,4 +1,4 @@
-#include "io/shot_manifest.h"
+#include "store/shot_manifest.h"
 
 #include <fmt/format.h>
 

@@ -1,6 +1,6 @@
 // The output folder of a shot: its layout (OutputPaths) and the Store that keeps layer results
 // and per-frame outputs there, every write atomic, each set of files under a manifest of the
-// settings that made it (io/shot_manifest.h).
+// settings that made it (store/shot_manifest.h).
 #pragma once
 
 #include <functional>
@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "io/output_store.h"
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "pipeline/shot.h"
+#include "store/output_store.h"
 
 namespace emaki::io {
 
@@ -54,7 +54,7 @@ enum class StoreMode {
 };
 
 // Layer frames and composited frames each carry a manifest of the settings that made them
-// (io/shot_manifest.h). Files made under other settings are never read back: `kRun` deletes
+// (store/shot_manifest.h). Files made under other settings are never read back: `kRun` deletes
 // and redoes them on the first write, `kReadFinished` throws emaki::Error naming the folder.
 class FileStore : public pipeline::Store {
  public:
@@ -76,7 +76,7 @@ class FileStore : public pipeline::Store {
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
-  // Every finished frame's field is kept (compressed, io/field_file.h, about a tenth of the
+  // Every finished frame's field is kept (compressed, store/field_file.h, about a tenth of the
   // uncompressed 8 bytes a pixel), so a run of frames a-b inside a finished shot starts frame a
   // from frame a - 1's field exactly as the uninterrupted run did. The field file is read as
   // hostile input: anything but the exact header (magic, version, frame, the shot's size, the

@@ -1,4 +1,4 @@
-#include "io/studio_passes.h"
+#include "store/studio_passes.h"
 
 #include <fmt/format.h>
 

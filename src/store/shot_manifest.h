@@ -1,12 +1,12 @@
-// The settings that made a shot's outputs, written beside them (io/output_store.h manifests):
+// The settings that made a shot's outputs, written beside them (store/output_store.h manifests):
 // a layer's frames depend on the source frames, the exemplar and the layer's synthesis settings;
 // the composited frames on the size and the layers' channel layout. Resuming compares them with
 // the shot as it is now, so that a changed size or layer setting redoes the work instead of
 // mixing old and new files.
 #pragma once
 
-#include "io/output_store.h"
 #include "pipeline/shot.h"
+#include "store/output_store.h"
 
 namespace emaki::io {
 

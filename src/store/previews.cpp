@@ -1,4 +1,4 @@
-#include "io/previews.h"
+#include "store/previews.h"
 
 #include <fmt/format.h>
 #include <spawn.h>
@@ -9,10 +9,10 @@
 #include <filesystem>
 
 #include "core/error.h"
-#include "io/file_store.h"
 #include "io/image_io.h"
-#include "io/shot_manifest.h"
 #include "pipeline/run.h"
+#include "store/file_store.h"
+#include "store/shot_manifest.h"
 
 extern char** environ;
 

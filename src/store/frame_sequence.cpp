@@ -1,4 +1,4 @@
-#include "io/frame_sequence.h"
+#include "store/frame_sequence.h"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/image_io.h"
-#include "io/studio_passes.h"
+#include "store/studio_passes.h"
 
 namespace emaki::io {
 

@@ -1,11 +1,10 @@
-#include "io/output_store.h"
+#include "io/temp_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <sstream>
 
 #include "core/error.h"
@@ -22,11 +21,11 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-class OutputStore : public ::testing::Test {
+class TempFiles : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("emaki_store_" + std::to_string(::getpid()) + "_" +
+           ("emaki_temp_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
@@ -50,7 +49,7 @@ TEST(TemporaryName, RecognisesOnlyEmakisPattern) {
   EXPECT_FALSE(is_temporary_name(".frame.emaki-tmp-0123456789abcdefx"));
 }
 
-TEST_F(OutputStore, TemporariesAreUnpredictableAndRemovedUnlessCommitted) {
+TEST_F(TempFiles, TemporariesAreUnpredictableAndRemovedUnlessCommitted) {
   const std::string target = (dir_ / "a.png").string();
   std::string first, second;
   {
@@ -68,7 +67,7 @@ TEST_F(OutputStore, TemporariesAreUnpredictableAndRemovedUnlessCommitted) {
   EXPECT_FALSE(fs::exists(target));
 }
 
-TEST_F(OutputStore, CommitReplacesASymlinkAtTheTargetWithoutFollowingIt) {
+TEST_F(TempFiles, CommitReplacesASymlinkAtTheTargetWithoutFollowingIt) {
   std::ofstream(dir_ / "victim") << "precious";
   fs::create_symlink(dir_ / "victim", dir_ / "a.txt");
   TempFile t((dir_ / "a.txt").string(), "a.txt");
@@ -79,7 +78,7 @@ TEST_F(OutputStore, CommitReplacesASymlinkAtTheTargetWithoutFollowingIt) {
   EXPECT_EQ(slurp(dir_ / "victim"), "precious");
 }
 
-TEST_F(OutputStore, ATemporarySwappedForASymlinkIsNotCommittedNorRemoved) {
+TEST_F(TempFiles, ATemporarySwappedForASymlinkIsNotCommittedNorRemoved) {
   std::ofstream(dir_ / "victim") << "precious";
   std::string path;
   {
@@ -94,7 +93,7 @@ TEST_F(OutputStore, ATemporarySwappedForASymlinkIsNotCommittedNorRemoved) {
   EXPECT_EQ(slurp(dir_ / "victim"), "precious");
 }
 
-TEST_F(OutputStore, CleanUpRemovesOnlyOurOwnRegularTemporaries) {
+TEST_F(TempFiles, CleanUpRemovesOnlyOurOwnRegularTemporaries) {
   auto touch = [&](const std::string& n) { std::ofstream(dir_ / n) << n; };
   touch(".vimrc.tmp");
   touch(".x.tmp123.png");
@@ -111,44 +110,6 @@ TEST_F(OutputStore, CleanUpRemovesOnlyOurOwnRegularTemporaries) {
   EXPECT_TRUE(fs::is_symlink(dir_ / ".frame_0002.emaki-tmp-0123456789abcdef.png"));
   EXPECT_TRUE(fs::is_directory(dir_ / ".frame_0003.emaki-tmp-0123456789abcdef.png"));
   EXPECT_EQ(slurp(dir_ / "target"), "target");
-}
-
-TEST_F(OutputStore, ASecondLockOnTheFolderNamesTheHolder) {
-  auto first = std::make_unique<FolderLock>(dir_.string());
-  try {
-    FolderLock second(dir_.string());
-    FAIL() << "the folder was locked twice";
-  } catch (const Error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(".emaki.lock"), std::string::npos) << what;
-    EXPECT_NE(what.find("pid " + std::to_string(::getpid())), std::string::npos) << what;
-  }
-  first.reset();
-  EXPECT_NO_THROW(FolderLock again(dir_.string()));
-}
-
-TEST_F(OutputStore, ManifestsRoundTripAndNameTheFirstChange) {
-  const std::string path = (dir_ / ".emaki-manifest").string();
-  EXPECT_FALSE(read_manifest(path));
-  const Manifest m = {"outputs_format = 1", "size = 32x24", "layers.base.single_colour = true"};
-  write_manifest(path, m);
-  const auto back = read_manifest(path);
-  ASSERT_TRUE(back);
-  EXPECT_EQ(*back, m);
-  EXPECT_EQ(manifest_difference(m, m), "");
-  Manifest changed = m;
-  changed[1] = "size = 40x30";
-  EXPECT_EQ(manifest_difference(m, changed), "size was 32x24, now 40x30");
-  changed.push_back("layers.base.channel = 0");
-  EXPECT_EQ(manifest_difference(m, {m[0], m[1], m[2], changed[3]}), "layers.base.channel is new");
-}
-
-TEST_F(OutputStore, FileDigestFollowsContent) {
-  std::ofstream(dir_ / "a") << "hello";
-  std::ofstream(dir_ / "b") << "hellp";
-  EXPECT_EQ(file_digest((dir_ / "a").string()), file_digest((dir_ / "a").string()));
-  EXPECT_NE(file_digest((dir_ / "a").string()), file_digest((dir_ / "b").string()));
-  EXPECT_EQ(file_digest((dir_ / "none").string()), "missing");
 }
 
 }  // namespace

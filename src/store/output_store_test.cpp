@@ -1,0 +1,69 @@
+#include "store/output_store.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "core/error.h"
+
+namespace emaki::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+class OutputStore : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("emaki_store_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(OutputStore, ASecondLockOnTheFolderNamesTheHolder) {
+  auto first = std::make_unique<FolderLock>(dir_.string());
+  try {
+    FolderLock second(dir_.string());
+    FAIL() << "the folder was locked twice";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(".emaki.lock"), std::string::npos) << what;
+    EXPECT_NE(what.find("pid " + std::to_string(::getpid())), std::string::npos) << what;
+  }
+  first.reset();
+  EXPECT_NO_THROW(FolderLock again(dir_.string()));
+}
+
+TEST_F(OutputStore, ManifestsRoundTripAndNameTheFirstChange) {
+  const std::string path = (dir_ / ".emaki-manifest").string();
+  EXPECT_FALSE(read_manifest(path));
+  const Manifest m = {"outputs_format = 1", "size = 32x24", "layers.base.single_colour = true"};
+  write_manifest(path, m);
+  const auto back = read_manifest(path);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(*back, m);
+  EXPECT_EQ(manifest_difference(m, m), "");
+  Manifest changed = m;
+  changed[1] = "size = 40x30";
+  EXPECT_EQ(manifest_difference(m, changed), "size was 32x24, now 40x30");
+  changed.push_back("layers.base.channel = 0");
+  EXPECT_EQ(manifest_difference(m, {m[0], m[1], m[2], changed[3]}), "layers.base.channel is new");
+}
+
+TEST_F(OutputStore, FileDigestFollowsContent) {
+  std::ofstream(dir_ / "a") << "hello";
+  std::ofstream(dir_ / "b") << "hellp";
+  EXPECT_EQ(file_digest((dir_ / "a").string()), file_digest((dir_ / "a").string()));
+  EXPECT_NE(file_digest((dir_ / "a").string()), file_digest((dir_ / "b").string()));
+  EXPECT_EQ(file_digest((dir_ / "none").string()), "missing");
+}
+
+}  // namespace
+}  // namespace emaki::io
