@@ -68,7 +68,17 @@ def median(runs, key):
 
 def spread(runs, key, fmt="{:.2f}"):
     v = [r[key] for r in runs]
+    if len(v) == 1:
+        return fmt.format(v[0])
     return (fmt + " ({}-{})").format(statistics.median(v), fmt.format(min(v)), fmt.format(max(v)))
+
+
+def runs_text(n, how="median"):
+    return "one run" if n == 1 else f"{how} of {n} runs"
+
+
+def times_text(n):
+    return "once each, alternated," if n == 1 else f"alternated {n} times"
 
 
 def thp_mode():
@@ -111,7 +121,7 @@ def section_synth(a, emaki, tmp):
     runs = [run_timed(cmd) for _ in range(a.runs)]
     lines = ["## Synthesis: EbSynth's StyLit example", "",
              "StyLit, 1200x912, a 3-channel style and 4 RGB guides at weight 0.5, default settings "
-             f"(the second command of `run_example.sh`); emaki median of {a.runs} runs:", "",
+             f"(the second command of `run_example.sh`); emaki {runs_text(a.runs)}:", "",
              "```sh", "E=examples/stylit", shown(cmd), "```", "",
              "| | wall s | CPU s | peak RSS MB | judge `style` | `joint` | `coverage` |",
              "|---|---|---|---|---|---|---|"]
@@ -154,7 +164,7 @@ def section_scaling(a, build):
     rows = re.findall(r"^\s*(\d+x\d+)\s+(\d+)\s+([0-9.]+)\s+([0-9.]+)\s*$", out, re.M)
     lines = ["## Synthesis time against image size", "",
              "The StyLit example at a quarter, half and full size (each halving low-passed), in "
-             f"memory, best of {a.runs}:", "", "```sh", shown(cmd), "```", "",
+             f"memory, {runs_text(a.runs, 'best')}:", "", "```sh", shown(cmd), "```", "",
              "| size | pixels | seconds | ns per pixel |", "|---|---|---|---|"]
     lines += [f"| {s} | {int(p):,} | {float(t):.3f} | {float(n):.0f} |" for s, p, t, n in rows]
     m = re.search(r"spread: \+-([0-9.]+) %", out)
@@ -174,7 +184,7 @@ def section_memory(a, emaki, tmp):
     lines = ["## Huge pages", "",
              f"The kernel's transparent-huge-page mode here: `{thp_mode()}` (emaki restarts "
              "itself with huge pages only in `madvise` mode). The StyLit command above, "
-             f"alternated {a.runs} times with `GLIBC_TUNABLES={HUGE_OFF}`:", "",
+             f"{times_text(a.runs)} with `GLIBC_TUNABLES={HUGE_OFF}`:", "",
              "| | wall s | CPU s | minor page faults |", "|---|---|---|---|",
              "| default | {} | {:.2f} | {:,.0f} |".format(spread(on, "wall"), median(on, "cpu"),
                                                           median(on, "faults")),
@@ -192,7 +202,7 @@ def section_render(a, build):
     cpu = statistics.median(float(v.group(2)) for v in vals)
     return ["## Guide passes", "",
             "emaki's renderer, the walking Fox, all 13 passes at 960x540 (2x2 samples), 8 frames, "
-            f"median of {a.runs} runs:", "", "```sh", shown(cmd), "```", "",
+            f"{runs_text(a.runs)}:", "", "```sh", shown(cmd), "```", "",
             "| | seconds per frame | CPU seconds per frame |", "|---|---|---|",
             f"| `render_bench` | {wall:.3f} | {cpu:.3f} |"]
 
@@ -201,7 +211,7 @@ def section_shot(a, build):
     sizes = [("960x540", 6)] + ([("1920x1080", 4)] if a.full else [])
     lines = ["## A shot in memory", "",
              "The bundled shot (three layers, temporal on) without files: rendering, synthesis, "
-             f"advection and compositing; median of {a.runs} runs:", "", "```sh"]
+             f"advection and compositing; {runs_text(a.runs)}:", "", "```sh"]
     rows = []
     for size, frames in sizes:
         cmd = [os.path.join(build, "bench", "shot_bench"), size, str(frames)]
@@ -251,7 +261,7 @@ def section_run(a, emaki, tmp):
         cmd = [emaki, "run", path] + extra
         runs.append(run_timed(cmd))
     shown_cmd = "emaki run examples/fox/shot.toml " + " ".join(extra)
-    lines += [f"{what}, into an empty output folder each time, median of {a.runs} runs "
+    lines += [f"{what}, into an empty output folder each time, {runs_text(a.runs)} "
               "(a copy of the shot writes under a temporary folder):", "",
               "```sh", shown_cmd.strip(), "```", "",
               "| | wall s | CPU s | minor page faults | peak RSS MB |", "|---|---|---|---|---|",
@@ -305,7 +315,7 @@ def section_python(a, build, emaki, tmp):
     same = os.path.exists(cli) and open(cli, "rb").read() == open(out, "rb").read()
     return ["## Python", "",
             "`examples/python/stylit.py` (the StyLit example through `emaki.synthesize`, the "
-            f"module's import and file reading included), alternated {a.runs} times with and "
+            f"module's import and file reading included), {times_text(a.runs)} with and "
             "without the huge-page tunable that `emaki` sets for itself:", "",
             "```sh", "PYTHONPATH=build/release/python /usr/bin/python3 examples/python/stylit.py "
             "OUT.png", "GLIBC_TUNABLES=glibc.malloc.hugetlb=1 PYTHONPATH=... (the same)", "```", "",
@@ -379,7 +389,8 @@ def main():
         "```sh", "/usr/bin/python3 bench/performance.py [--full] [--ebsynth PATH] [--judge PATH]"
         " > docs/performance.md", "```", "",
         "Figures vary between machines and with whatever else runs on them: compare them as "
-        "ratios between rows measured in one run, not with figures from another machine. This "
+        "ratios between rows measured in one run, not with figures from another machine; on a "
+        "shared machine CPU seconds and page faults say more than wall seconds. This "
         "run: `bench/performance.py{}` on {} ({} cores), load average {:.1f} at the start and "
         "{:.1f} at the end (other jobs shared the machine when above the core count), "
         "{:.0f} s.".format(" " + args if args else "", cpu_model(), os.cpu_count(), load0,
