@@ -2,7 +2,7 @@
 // kernel faults it in 4 KB at a time. On a kernel whose THP mode is "madvise", glibc's tunable
 // glibc.malloc.hugetlb=1 has malloc advise huge pages on what it maps: 2 MB per fault instead of
 // 4 KB (a 6-frame `emaki run` of the example: 0.56 M page faults -> 0.03 M, wall -20 to -35 %;
-// docs/eval.md, "Huge pages"). Tunables are read only when a program starts, so `emaki` starts
+// docs/design/huge-pages.md). Tunables are read only when a program starts, so `emaki` starts
 // itself again once with the tunable added. Outputs do not change: only where memory comes from.
 #pragma once
 

@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
   // also turns off glibc's adaptive one, and then every image of 1 MB or more was mapped anew and
   // unmapped when freed. A 6-frame `emaki run` of the example took 1.48 M page faults (3.5-4.3
   // system seconds) that way, 0.55 M without it: wall -9 %, peak RSS 674 -> 770 MB
-  // (docs/eval.md, "Files and memory around the engine"). Huge pages took most of the rest.
+  // (docs/design/huge-pages.md). Huge pages took most of the rest.
   restart_with_huge_pages(argv);
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     print_usage();

@@ -6,8 +6,8 @@
 // another in a single zlib stream, whose Adler-32 is combined from the strips'. The bytes are
 // therefore the same for any thread count. zlib's run-length strategy only looks one byte back,
 // so a strip loses nothing by not seeing the one before it. Measured with `emaki synth` (wall
-// time outside reading and synthesis, two threads; docs/eval.md): 2048^2 0.74-0.77 s -> 0.08 s,
-// StyLit 1200x912 0.13-0.16 s -> 0.03-0.05 s; the files are 2 % smaller to 4 % larger.
+// time outside reading and synthesis, two threads; docs/design/engine-speed.md): 2048^2 0.74-0.77 s
+// -> 0.08 s, StyLit 1200x912 0.13-0.16 s -> 0.03-0.05 s; the files are 2 % smaller to 4 % larger.
 #include <pnglibconf.h>
 #include <zlib.h>
 

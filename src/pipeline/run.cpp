@@ -61,8 +61,8 @@ struct LayerFrame {
 // The main transfer's schedule with a warm start, unless the layer sets its own counts (which
 // then hold at that one level as at every other): the finest level alone, one search-vote
 // iteration of two PatchMatch sweeps within 32 pixels — what the whole pyramid's finest level
-// runs at a temporal frame. Measured on the example (docs/temporal.md): a random search over
-// the whole exemplar, or two search-vote iterations, evaluate more candidates and lowered the
+// runs at a temporal frame. Measured on the example (docs/design/warm-start.md): a random search
+// over the whole exemplar, or two search-vote iterations, evaluate more candidates and lowered the
 // judge's style energy by 0.7-2.2 % only (frames 4 and 12).
 void warm_schedule(const SynthSpec& s, synth::Params& p) {
   if (s.search_vote_iters >= 0 || s.patch_match_iters >= 0) return;
@@ -120,8 +120,8 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
   // With a temporal guide, B'adv already carries the previous frame's converged texture: one
   // search-vote iteration at the finest level instead of two keeps flicker and the judge's
-  // style energy within their bars (measured on the example, docs/temporal.md) and saves about
-  // a quarter of the time per frame.
+  // style energy within their bars (measured on the example, docs/design/advection.md) and saves
+  // about a quarter of the time per frame.
   Image<int32_t> warm;
   if (!advected.value.empty()) {
     params.finest_search_vote_iters = 1;

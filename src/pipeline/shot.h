@@ -120,11 +120,11 @@ struct TemporalSpec {
   // the temporal guide holding the layout, the term pushes the exemplar's least used patches
   // into wherever that guide is weakest, where the chain then keeps them (a pale streak behind
   // a moving object at 3500); without it the chain settles into flat, textureless regions. 1000
-  // is the middle measured on the example (docs/temporal.md).
+  // is the middle measured on the example (docs/design/temporal-uniformity.md).
   float uniformity = 1000.0f;
   // The main transfer at a temporal frame starts at the finest pyramid level from the previous
   // frame's field carried along the advection, instead of the whole pyramid from a random field
-  // (docs/temporal.md). Off: every frame runs the whole pyramid, as before it existed.
+  // (docs/design/warm-start.md). Off: every frame runs the whole pyramid, as before it existed.
   bool warm_start = true;
   // Which warm-start fields a run keeps on disk: every finished frame's (a forced --frames range
   // inside a finished shot then continues exactly), or the last finished frame's alone (a

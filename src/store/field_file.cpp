@@ -22,8 +22,8 @@ struct FieldHeader {
 };
 static_assert(sizeof(FieldHeader) == kFieldHeaderBytes);
 
-// zlib level 1: measured on the example's base layer at 960x540 (docs/temporal.md), level 6 makes
-// the file a fifth smaller for several times the time.
+// zlib level 1: measured on the example's base layer at 960x540 (docs/design/warm-start.md), level
+// 6 makes the file a fifth smaller for several times the time.
 constexpr int kLevel = 1;
 
 std::size_t raw_bytes(int width, int height) {

@@ -1,7 +1,7 @@
 // The file of a temporal layer's field at one frame (the next frame's warm start,
 // pipeline::Store::write_field): a 32-byte header, then the field's entries, each as the
 // difference to its left neighbour (the first of a row as it is), zlib-compressed. A field is
-// mostly runs of +1 steps, so it shrinks about tenfold (docs/temporal.md has the figures).
+// mostly runs of +1 steps, so it shrinks about tenfold (docs/design/warm-start.md has the figures).
 // The reader takes the bytes as hostile input: it gives an empty field, never a crash, for
 // anything but the exact header the caller expects and a zlib stream that decompresses to
 // exactly width x height x 2 entries with nothing after it.

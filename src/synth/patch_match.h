@@ -26,10 +26,11 @@ namespace emaki::synth {
 // The target is swept in at most kBands bands (of at least kMinBandRows rows), in kRounds rounds
 // of kBands / kRounds bands at once. Bands of one round see each other's occupancy only from the
 // next round on: on smooth exemplars over flat guides (the MatCaps of bench/eval_set.py,
-// docs/eval.md) bands that run blind to each other crowd onto the same best-fitting source region
-// and the output is mottled. Judge style on the Cornell box MatCap pair (EbSynth 0.000145), with
-// the vote of voting.cpp: 8 bands in 2 rounds 0.000227, 16 in 4 rounds 0.000167, 8 in 4 0.000162
-// (8 bands at once, with the former vote: 0.000358). 16 in 4 keeps 4 threads busy.
+// docs/design/deterministic-bands.md) bands that run blind to each other crowd onto the same
+// best-fitting source region and the output is mottled. Judge style on the Cornell box MatCap pair
+// (EbSynth 0.000145), with the vote of voting.cpp: 8 bands in 2 rounds 0.000227, 16 in 4 rounds
+// 0.000167, 8 in 4 0.000162 (8 bands at once, with the former vote: 0.000358). 16 in 4 keeps 4
+// threads busy.
 inline constexpr int kBands = 16;
 inline constexpr int kRounds = 4;  // >= 2: adjacent bands never run at once
 inline constexpr int kMinBandRows = 16;

@@ -200,10 +200,10 @@ std::vector<LevelSchedule> make_schedule(const Params& p, int levels) {
   // exemplar with EbSynth's counts, the third-finest level included. The two finest levels cost
   // 15/16 of the time and start from a field that is already good, so they refine it with fewer
   // iterations and a bounded search radius. Measured with the judge at full size on StyLit and
-  // FaceStyle (see README): style, joint and coverage hold against EbSynth's 6 x 4 at every
-  // level. (One search-vote iteration at the finest level was enough for StyLit but not for
-  // FaceStyle's joint energy.) The third-finest level ran 3 x 3 until the evaluation set
-  // (bench/eval_set.py, docs/eval.md) showed 6 x 4 there worth it: worst joint 1.119x -> 1.098x
+  // FaceStyle (docs/design/engine-schedule.md): style, joint and coverage hold against
+  // EbSynth's 6 x 4 at every level. (One search-vote iteration at the finest level was enough for
+  // StyLit but not for FaceStyle's joint energy.) The third-finest level ran 3 x 3 until the
+  // evaluation set (bench/eval_set.py) showed 6 x 4 there worth it: worst joint 1.119x -> 1.098x
   // EbSynth's, mean style 1.037x -> 1.022x.
   for (int l = 0; l < levels; ++l) {
     const int from_finest = levels - 1 - l;
@@ -498,10 +498,10 @@ struct Solve {
       run_patch_match(pm, cfg);
       // The output (the last vote of the finest level, or of the 3x3 pass) is plain even in
       // weighted mode: the weights steer the search, but a plain average joins the output's
-      // patches more smoothly. Measured with bench/eval_set.py (docs/eval.md): mean judge style
-      // 1.022x -> 0.960x EbSynth's (jade MatCap 1.300x -> 0.997x), worst joint 1.098x -> 1.076x;
-      // worse style only on the toon MatCap (1.046x -> 1.101x) and the stippling (0.995x ->
-      // 1.013x).
+      // patches more smoothly. Measured with bench/eval_set.py (docs/design/engine-schedule.md):
+      // mean judge style 1.022x -> 0.960x EbSynth's (jade MatCap 1.300x -> 0.997x), worst
+      // joint 1.098x -> 1.076x; worse style only on the toon MatCap (1.046x -> 1.101x) and the
+      // stippling (0.995x -> 1.013x).
       const bool output = last && it + 1 == sch.search_vote_iters;
       vote(source_style(L, l), nnf, err, L.active, patch,
            output ? VoteMode::kPlain : params.vote_mode, style);

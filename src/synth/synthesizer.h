@@ -9,9 +9,9 @@
 //
 // Per-pixel weights. A guide pair may carry a weight map over the target: the guide's share of
 // the error of the patch centred at target pixel p is its weight times map(p) (the map at the
-// patch centre, for every pixel of the patch; docs/temporal.md has the measurement behind that
-// choice). The map's values are quantised to 1/65536 and the weighted sum stays an exact
-// integer; a map of ones gives the same result, bit for bit, as no map.
+// patch centre, for every pixel of the patch; docs/design/temporal-confidence.md has the
+// measurement behind that choice). The map's values are quantised to 1/65536 and the weighted sum
+// stays an exact integer; a map of ones gives the same result, bit for bit, as no map.
 //
 // Precision. Each channel is quantised to 16383 * sqrt(weight_c / max_weight) levels over its
 // range (14 bits for the heaviest channel; at least 12 bits for every channel whose weight is

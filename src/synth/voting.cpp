@@ -137,8 +137,8 @@ void vote_impl(ImageView<const T> source, const Image<int32_t>& nnf, const Image
   // error per patch pixel and channel (EbSynth's units). With the softness, patches that agree
   // within about 10/255 RMS count nearly alike and only worse ones lose weight; at 1 (the former
   // 1 / (1 + e)) smooth exemplars came out as a patchwork of flat cells. Measured with
-  // bench/eval_set.py (docs/eval.md): judge `style` on the MatCap pairs 1.2-2.5x EbSynth's at 1,
-  // 1.05-2.1x at 100, while StyLit and FaceStyle stay under EbSynth's.
+  // bench/eval_set.py (docs/design/engine-schedule.md): judge `style` on the MatCap pairs 1.2-2.5x
+  // EbSynth's at 1, 1.05-2.1x at 100, while StyLit and FaceStyle stay under EbSynth's.
   const bool plain = mode == VoteMode::kPlain;
   Image<float> weight;
   if (!plain) weight.reset(tw, th, 1);

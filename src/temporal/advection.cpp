@@ -22,7 +22,7 @@ synth::Params field_params(const synth::Params& params, int search_radius, int w
   p.patch_match_iters = 2;
   // Matched on the position guide alone: B'(t-1) is only carried along. A style term would
   // compare it with the current estimate of B'adv, which starts as the unmoved B'(t-1), and
-  // hold patches back where the frame moved (measured: more flicker, docs/temporal.md).
+  // hold patches back where the frame moved (measured: more flicker, docs/design/advection.md).
   p.style_weight = 0.0f;
   p.search_radius = search_radius > 0
                         ? search_radius

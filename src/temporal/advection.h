@@ -66,8 +66,8 @@ AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& p
 // iteration of two PatchMatch sweeps at full resolution, random search within
 // `search_radius`, refines it. Measured on the example against the main transfer's multiscale
 // schedule with a style weight of 1 against the guide's 1000: less flicker and a third of the
-// advection's time (docs/temporal.md). The field covers the whole frame; with a mask, B'adv is
-// voted inside it (dilated by the patch radius, as the synthesizer does) from the patches
+// advection's time (docs/design/advection.md). The field covers the whole frame; with a mask, B'adv
+// is voted inside it (dilated by the patch radius, as the synthesizer does) from the patches
 // centred there.
 Advection advect(const AdvectionInputs& in, const synth::Params& params,
                  const AdvectionField* field = nullptr);

@@ -2,10 +2,10 @@
 // the advection's field; at a pixel whose surface point was hidden at t-1 (ground uncovered by
 // a swinging tail, a limb passing in front) there is nothing right to carry, and B'adv holds a
 // stretched copy of what lay next to the cover, bled into by the cover's own patches: kept by
-// the main transfer, it becomes a streak that trails the cover (docs/temporal.md). The
-// confidence is 1 where the advection's own evidence says the surface was visible and carried
-// from itself, 0 where it was not, and the main transfer uses it as the temporal guide's
-// weight map.
+// the main transfer, it becomes a streak that trails the cover
+// (docs/design/temporal-confidence.md). The confidence is 1 where the advection's own evidence says
+// the surface was visible and carried from itself, 0 where it was not, and the main transfer uses
+// it as the temporal guide's weight map.
 #pragma once
 
 #include "core/image.h"
@@ -39,7 +39,8 @@ Image<uint8_t> visible_before(const Surfaces& s, float tolerance = 3.0f);
 Image<float> foreign_share(const Image<int32_t>& nnf, const Surfaces& s, int patch_size,
                            int footprint);
 
-// How the evidence becomes a confidence (defaults measured on the example, docs/temporal.md).
+// How the evidence becomes a confidence (defaults measured on the example,
+// docs/design/temporal-confidence.md).
 struct ConfidenceParams {
   // The advection's patch error as an RMS guide difference per channel (guide values in [0, 1]):
   // full confidence up to error_full, none from error_none, linear between.

@@ -13,7 +13,7 @@
 # "emaki" panel to the Output properties: render the passes of the frame range, and stylize the
 # current frame in Blender through emaki's Python module (emaki_stylize.py).
 #
-# How each pass is made (the README's "Studio renders" section has the conventions):
+# How each pass is made (docs/blender.md has the conventions):
 #   normal, position, position_norm, rest_position, depth: a shader AOV written by a node group
 #     that the exporter adds to every material (camera-space normal via Vector Transform;
 #     position swizzled from Blender's Z-up to +Y-up; rest position from the undeformed

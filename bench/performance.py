@@ -1,0 +1,418 @@
+#!/usr/bin/python3
+"""Measures emaki on the bundled examples and prints docs/performance.md's tables (Markdown),
+each under the command that makes it, so a figure there is re-measured, never edited.
+
+Builds nothing: it runs the release build's programs (`emaki`, `bench/synth_bench`,
+`bench/render_bench`, `bench/shot_bench`, `bench/temporal_bench`) and the Python module at modest
+sizes; the default run takes a few minutes on 2 cores. Wall seconds depend on the machine and on
+whatever else runs on it: compare figures as ratios, measured in one run of this script.
+
+    /usr/bin/python3 bench/performance.py [--build build/release] [--runs 3] [--full]
+        [--only synth,scaling,memory,render,shot,run,temporal,python]
+        [--ebsynth PATH/TO/ebsynth] [--judge PATH/TO/judge] > performance.md
+
+--full measures the bundled shot at its own size and length (48 frames, 960x540, previews: the
+README's command) and the temporal table over 48 frames at 960x540, instead of 6 frames and
+16 frames at 480x270. --ebsynth adds EbSynth's CPU build (built outside the project:
+jamriska/ebsynth) on the same StyLit command line; --judge (../shared/tools/judge, built with its
+build.sh) adds the judge's figures of both outputs and of the temporal variants.
+"""
+
+import argparse
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+STYLIT = os.path.join(ROOT, "examples", "stylit")
+GUIDES = ("fullgi", "dirdif", "dirspc", "indirb")
+HUGE_OFF = "glibc.malloc.hugetlb=0"
+HUGE_ON = "glibc.malloc.hugetlb=1"
+
+
+def stylit_args():
+    a = ["-style", os.path.join(STYLIT, "source_style.png")]
+    for g in GUIDES:
+        a += ["-guide", os.path.join(STYLIT, f"source_{g}.png"),
+              os.path.join(STYLIT, f"target_{g}.png"), "-weight", "0.5"]
+    return a
+
+
+def run_timed(cmd, env=None, cwd=None):
+    """Runs cmd; returns its wall seconds, CPU seconds (user + system), minor page faults, peak
+    RSS in MB (the child's own, from wait4) and stdout. Exits with its error when it fails."""
+    e = dict(os.environ)
+    e.update(env or {})
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        t0 = time.monotonic()
+        p = subprocess.Popen(cmd, stdout=out, stderr=err, env=e, cwd=cwd, text=True)
+        _, status, ru = os.wait4(p.pid, 0)
+        wall = time.monotonic() - t0
+        p.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        if p.returncode != 0:
+            sys.exit(f"performance.py: {shown(cmd)} failed ({p.returncode}): "
+                     f"{err.read().strip()[-400:]}")
+        return dict(wall=wall, cpu=ru.ru_utime + ru.ru_stime, faults=ru.ru_minflt,
+                    rss=ru.ru_maxrss / 1024, out=out.read())
+
+
+def median(runs, key):
+    return statistics.median(r[key] for r in runs)
+
+
+def spread(runs, key, fmt="{:.2f}"):
+    v = [r[key] for r in runs]
+    if len(v) == 1:
+        return fmt.format(v[0])
+    return (fmt + " ({}-{})").format(statistics.median(v), fmt.format(min(v)), fmt.format(max(v)))
+
+
+def runs_text(n, how="median"):
+    return "one run" if n == 1 else f"{how} of {n} runs"
+
+
+def times_text(n):
+    return "once each, alternated," if n == 1 else f"alternated {n} times"
+
+
+def thp_mode():
+    try:
+        text = open("/sys/kernel/mm/transparent_hugepage/enabled").read()
+        m = re.search(r"\[(\w+)\]", text)
+        return m.group(1) if m else text.strip()
+    except OSError:
+        return "unknown"
+
+
+def cpu_model():
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown"
+
+
+SCRATCH = []  # the temporary folder, shown as OUT
+
+
+def shown(cmd):
+    """A command as the reader would type it from the repository root (E=examples/stylit)."""
+    s = " ".join(cmd).replace(STYLIT + "/", "$E/").replace(ROOT + "/", "")
+    for t in SCRATCH:
+        s = s.replace(t, "OUT")
+    return s.replace(" -guide", " \\\n    -guide").replace(" -output", " \\\n    -output")
+
+
+# ---------------------------------------------------------------------------------------------
+# Sections: each returns Markdown lines.
+
+
+def section_synth(a, emaki, tmp):
+    out = os.path.join(tmp, "stylit.png")
+    cmd = [emaki, "synth"] + stylit_args() + ["-output", out, "--quiet"]
+    runs = [run_timed(cmd) for _ in range(a.runs)]
+    lines = ["## Synthesis: EbSynth's StyLit example", "",
+             "StyLit, 1200x912, a 3-channel style and 4 RGB guides at weight 0.5, default settings "
+             f"(the second command of `run_example.sh`); emaki {runs_text(a.runs)}:", "",
+             "```sh", "E=examples/stylit", shown(cmd), "```", "",
+             "| | wall s | CPU s | peak RSS MB | judge `style` | `joint` | `coverage` |",
+             "|---|---|---|---|---|---|---|"]
+    judged = judge_stylit(a, out) if a.judge else None
+    lines.append("| emaki | {} | {:.2f} | {} | {} |".format(
+        spread(runs, "wall"), median(runs, "cpu"), f"{median(runs, 'rss'):.0f}",
+        " | ".join(judged) if judged else "- | - | -"))
+    if a.ebsynth:
+        eout = os.path.join(tmp, "stylit_ebsynth.png")
+        ecmd = [a.ebsynth] + stylit_args() + ["-output", eout]
+        e = run_timed(ecmd)
+        ej = judge_stylit(a, eout) if a.judge else None
+        lines.append("| EbSynth (CPU build, one run) | {:.2f} | {:.2f} | {} | {} |".format(
+            e["wall"], e["cpu"], f"{e['rss']:.0f}",
+            " | ".join(ej) if ej else "- | - | -"))
+        lines += ["", "EbSynth / emaki: **{:.1f}x** wall, {:.1f}x CPU.".format(
+            e["wall"] / median(runs, "wall"), e["cpu"] / median(runs, "cpu"))]
+    else:
+        lines += ["", "(EbSynth's column: `--ebsynth PATH`.)"]
+    return lines
+
+
+def judge_stylit(a, output):
+    cmd = [a.judge, "-style", os.path.join(STYLIT, "source_style.png")]
+    for g in GUIDES:
+        cmd += ["-guide", os.path.join(STYLIT, f"source_{g}.png"),
+                os.path.join(STYLIT, f"target_{g}.png"), "-weight", "0.5"]
+    p = subprocess.run(cmd + ["-output-to-judge", output], capture_output=True, text=True)
+    m = {k: re.search(rf'"{k}":\s*([0-9.eE+-]+)', p.stdout) for k in ("style", "joint", "coverage")}
+    if p.returncode != 0 or not all(m.values()):
+        sys.exit(f"performance.py: the judge failed on {output}: {p.stderr.strip()[-300:]}")
+    return ["{:.6f}".format(float(m["style"].group(1))),
+            "{:.6f}".format(float(m["joint"].group(1))),
+            "{:.3f}".format(float(m["coverage"].group(1)))]
+
+
+def section_scaling(a, build):
+    cmd = [os.path.join(build, "bench", "synth_bench"), "--repeat", str(a.runs)]
+    out = run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON})["out"]
+    rows = re.findall(r"^\s*(\d+x\d+)\s+(\d+)\s+([0-9.]+)\s+([0-9.]+)\s*$", out, re.M)
+    lines = ["## Synthesis time against image size", "",
+             "The StyLit example at a quarter, half and full size (each halving low-passed), in "
+             f"memory, {runs_text(a.runs, 'best')}:", "", "```sh", shown(cmd), "```", "",
+             "| size | pixels | seconds | ns per pixel |", "|---|---|---|---|"]
+    lines += [f"| {s} | {int(p):,} | {float(t):.3f} | {float(n):.0f} |" for s, p, t, n in rows]
+    m = re.search(r"spread: \+-([0-9.]+) %", out)
+    if m:
+        lines += ["", f"Time per pixel within +-{m.group(1)} % across the three sizes."]
+    return lines
+
+
+def section_memory(a, emaki, tmp):
+    """The huge-page restart: the same command with the tunable turned off, runs alternated."""
+    out = os.path.join(tmp, "stylit_thp.png")
+    cmd = [emaki, "synth"] + stylit_args() + ["-output", out, "--quiet"]
+    on, off = [], []
+    for _ in range(a.runs):
+        on.append(run_timed(cmd))
+        off.append(run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_OFF}))
+    lines = ["## Huge pages", "",
+             f"The kernel's transparent-huge-page mode here: `{thp_mode()}` (emaki restarts "
+             "itself with huge pages only in `madvise` mode). The StyLit command above, "
+             f"{times_text(a.runs)} with `GLIBC_TUNABLES={HUGE_OFF}`:", "",
+             "| | wall s | CPU s | minor page faults |", "|---|---|---|---|",
+             "| default | {} | {:.2f} | {:,.0f} |".format(spread(on, "wall"), median(on, "cpu"),
+                                                          median(on, "faults")),
+             "| `GLIBC_TUNABLES={}` | {} | {:.2f} | {:,.0f} |".format(
+                 HUGE_OFF, spread(off, "wall"), median(off, "cpu"), median(off, "faults"))]
+    return lines
+
+
+def section_render(a, build):
+    cmd = [os.path.join(build, "bench", "render_bench"),
+           os.path.join(ROOT, "examples", "data", "Fox.glb"), "8", "960x540"]
+    outs = [run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON})["out"] for _ in range(a.runs)]
+    vals = [re.search(r"([0-9.]+) s/frame \(wall\), ([0-9.]+) CPU s/frame", o) for o in outs]
+    wall = statistics.median(float(v.group(1)) for v in vals)
+    cpu = statistics.median(float(v.group(2)) for v in vals)
+    return ["## Guide passes", "",
+            "emaki's renderer, the walking Fox, all 13 passes at 960x540 (2x2 samples), 8 frames, "
+            f"{runs_text(a.runs)}:", "", "```sh", shown(cmd), "```", "",
+            "| | seconds per frame | CPU seconds per frame |", "|---|---|---|",
+            f"| `render_bench` | {wall:.3f} | {cpu:.3f} |"]
+
+
+def section_shot(a, build):
+    sizes = [("960x540", 6)] + ([("1920x1080", 4)] if a.full else [])
+    lines = ["## A shot in memory", "",
+             "The bundled shot (three layers, temporal on) without files: rendering, synthesis, "
+             f"advection and compositing; {runs_text(a.runs)}:", "", "```sh"]
+    rows = []
+    for size, frames in sizes:
+        cmd = [os.path.join(build, "bench", "shot_bench"), size, str(frames)]
+        lines.append(shown(cmd))
+        outs = [run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON})["out"] for _ in range(a.runs)]
+        f0 = statistics.median(float(re.search(r"\(no temporal\) ([0-9.]+) s", o).group(1))
+                               for o in outs)
+        ft = statistics.median(float(re.search(r"\(temporal\) ([0-9.]+) s", o).group(1))
+                               for o in outs)
+        steps = {}
+        for o in outs:
+            for name, s in re.findall(r" (\w+) ([0-9.]+) s", o.split("per temporal frame:")[1]):
+                steps.setdefault(name, []).append(float(s))
+        split = ", ".join(f"{n} {statistics.median(v):.2f}" for n, v in steps.items())
+        rows.append(f"| {size} | {f0:.2f} | {ft:.2f} | {split} |")
+    lines += ["```", "",
+              "| size | frame 0 s | temporal frame s | per temporal frame, by step (s) |",
+              "|---|---|---|---|"] + rows
+    lines += ["", "Frame 0 runs the whole pyramid; temporal frames start from the previous "
+              "frame's field. A layer's step includes its advection, the first layer's the frame's "
+              "rendering."]
+    return lines
+
+
+def shot_copy(tmp, name):
+    """examples/fox/shot.toml with absolute input paths and its outputs under tmp."""
+    text = open(os.path.join(ROOT, "examples", "fox", "shot.toml")).read()
+    text = text.replace('"../', '"' + os.path.join(ROOT, "examples") + "/")
+    folder = os.path.join(tmp, name)
+    text = re.sub(r'^folder = "out"', f'folder = "{folder}"', text, flags=re.M)
+    path = os.path.join(tmp, name + ".toml")
+    open(path, "w").write(text)
+    return path
+
+
+def section_run(a, emaki, tmp):
+    lines = ["## The bundled shot, with its files", ""]
+    if a.full:
+        what = "`emaki run examples/fox/shot.toml`: 48 frames at 960x540 with previews"
+        extra = []
+    else:
+        what = "`emaki run examples/fox/shot.toml`, frames 0-5, no previews"
+        extra = ["--frames", "0-5", "--no-previews"]
+    runs = []
+    for i in range(a.runs):
+        path = shot_copy(tmp, f"run{i}")
+        cmd = [emaki, "run", path] + extra
+        runs.append(run_timed(cmd))
+    shown_cmd = "emaki run examples/fox/shot.toml " + " ".join(extra)
+    lines += [f"{what}, into an empty output folder each time, {runs_text(a.runs)} "
+              "(a copy of the shot writes under a temporary folder):", "",
+              "```sh", shown_cmd.strip(), "```", "",
+              "| | wall s | CPU s | minor page faults | peak RSS MB |", "|---|---|---|---|---|",
+              "| emaki run | {} | {:.1f} | {:,.0f} | {} |".format(
+                  spread(runs, "wall", "{:.1f}"), median(runs, "cpu"), median(runs, "faults"),
+                  f"{median(runs, 'rss'):.0f}")]
+    return lines
+
+
+def section_temporal(a, build):
+    size, frames = ("960x540", 48) if a.full else ("480x270", 16)
+    cmd = [os.path.join(build, "bench", "temporal_bench"), "--size", size, "--frames",
+           str(frames), "--variants", "frame,position,rest_position"]
+    if a.judge:
+        cmd += ["--judge", a.judge, "--judge-every", "8"]
+    out = run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON})["out"]
+    lines = ["## Temporal: flicker and ghosts", "",
+             f"The bundled shot's base layer at {size}, frames 0-{frames - 1}: frame by frame "
+             "(`temporal = false`), and with advection by world `position` or by `rest_position` "
+             "(the default), each with the shot's other temporal settings. Flicker is "
+             "`emaki qa flicker`'s measure (objects: the Fox), ghost share `emaki qa ghost`'s, "
+             "drift the mean value against frame by frame over the last quarter of the frames, "
+             "in levels of 255:", "", "```sh", shown(cmd), "```", "",
+             "| variant | flicker | Fox | ground | vs frame by frame | judge `style` | coverage "
+             "| ghost share | drift |", "|---|---|---|---|---|---|---|---|---|"]
+    if not a.judge:  # no judge columns
+        lines[-2:] = ["| variant | flicker | Fox | ground | vs frame by frame | ghost share "
+                      "| drift |", "|---|---|---|---|---|---|---|"]
+    row = re.compile(r"^(\S+)\s+[\d.]+\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+x)\s+"
+                     r"(-|[\d.]+(?: \([+-][\d.]+ %\))?)\s+(\S+)\s+(\S+)\s+\S+\s+\S+\s+(\S+)$")
+    for line in out.splitlines():
+        m = row.match(line.strip())
+        if m:
+            g = list(m.groups())
+            if not a.judge:
+                del g[5:7]
+            lines.append("| " + " | ".join(g) + " |")
+    return lines
+
+
+def section_python(a, build, emaki, tmp):
+    env = {"PYTHONPATH": os.path.join(build, "python")}
+    script = os.path.join(ROOT, "examples", "python", "stylit.py")
+    out = os.path.join(tmp, "stylit_py.png")
+    cmd = ["/usr/bin/python3", script, out]
+    plain, tuned = [], []
+    for _ in range(a.runs):
+        plain.append(run_timed(cmd, env=env, cwd=ROOT))
+        tuned.append(run_timed(cmd, env=dict(env, GLIBC_TUNABLES=HUGE_ON), cwd=ROOT))
+    cli = os.path.join(tmp, "stylit.png")
+    same = os.path.exists(cli) and open(cli, "rb").read() == open(out, "rb").read()
+    return ["## Python", "",
+            "`examples/python/stylit.py` (the StyLit example through `emaki.synthesize`, the "
+            f"module's import and file reading included), {times_text(a.runs)} with and "
+            "without the huge-page tunable that `emaki` sets for itself:", "",
+            "```sh", "PYTHONPATH=build/release/python /usr/bin/python3 examples/python/stylit.py "
+            "OUT.png", "GLIBC_TUNABLES=glibc.malloc.hugetlb=1 PYTHONPATH=... (the same)", "```", "",
+            "| | wall s | CPU s | minor page faults |", "|---|---|---|---|",
+            "| plain | {} | {:.2f} | {:,.0f} |".format(spread(plain, "wall"), median(plain, "cpu"),
+                                                       median(plain, "faults")),
+            "| `GLIBC_TUNABLES={}` | {} | {:.2f} | {:,.0f} |".format(
+                HUGE_ON, spread(tuned, "wall"), median(tuned, "cpu"), median(tuned, "faults")),
+            "", "Its PNG is {} `emaki synth`'s.".format(
+                "the same file as" if same else "NOT the same file as" if os.path.exists(cli)
+                else "to be compared with")]
+
+
+SECTIONS = ("synth", "scaling", "memory", "render", "shot", "run", "temporal", "python")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
+    p.add_argument("--runs", type=int, default=3)
+    p.add_argument("--full", action="store_true")
+    p.add_argument("--only", default=",".join(SECTIONS))
+    p.add_argument("--ebsynth")
+    p.add_argument("--judge")
+    a = p.parse_args()
+    only = a.only.split(",")
+    bad = [s for s in only if s not in SECTIONS]
+    if bad:
+        sys.exit(f"performance.py: --only: unknown section {bad[0]!r} "
+                 f"(sections: {', '.join(SECTIONS)})")
+    build = os.path.abspath(a.build)
+    emaki = os.path.join(build, "apps", "emaki", "emaki")
+    if not os.access(emaki, os.X_OK):
+        sys.exit(f"performance.py: --build: no {emaki}: build the release preset first")
+    t0, load0 = time.monotonic(), os.getloadavg()[0]
+    lines = []
+    with tempfile.TemporaryDirectory(prefix="emaki_performance_") as tmp:
+        SCRATCH.append(tmp)
+        for name in SECTIONS:
+            if name not in only:
+                continue
+            print(f"performance.py: {name} ...", file=sys.stderr)
+            if name == "synth":
+                lines += section_synth(a, emaki, tmp)
+            elif name == "scaling":
+                lines += section_scaling(a, build)
+            elif name == "memory":
+                lines += section_memory(a, emaki, tmp)
+            elif name == "render":
+                lines += section_render(a, build)
+            elif name == "shot":
+                lines += section_shot(a, build)
+            elif name == "run":
+                lines += section_run(a, emaki, tmp)
+            elif name == "temporal":
+                lines += section_temporal(a, build)
+            else:
+                lines += section_python(a, build, emaki, tmp)
+            lines.append("")
+    argv = sys.argv[1:]
+    for i, x in enumerate(argv[:-1]):
+        if x in ("--ebsynth", "--judge", "--build"):
+            argv[i + 1] = "PATH"
+    argv = [re.sub(r"^(--(?:ebsynth|judge|build)=).*", r"\1PATH", x) for x in argv]
+    args = " ".join(argv)
+    header = [
+        "# Performance", "",
+        "Every figure on this page is printed by `bench/performance.py`, which runs the release "
+        "build's programs on the bundled examples; the page is its output. To measure your "
+        "machine, build the release preset and run", "",
+        "```sh", "/usr/bin/python3 bench/performance.py [--full] [--ebsynth PATH] [--judge PATH]"
+        " > docs/performance.md", "```", "",
+        "Figures vary between machines and with whatever else runs on them: compare them as "
+        "ratios between rows measured in one run, not with figures from another machine; on a "
+        "shared machine CPU seconds and page faults say more than wall seconds. This "
+        "run: `bench/performance.py{}` on {} ({} cores), load average {:.1f} at the start and "
+        "{:.1f} at the end (other jobs shared the machine when above the core count), "
+        "{:.0f} s.".format(" " + args if args else "", cpu_model(), os.cpu_count(), load0,
+                           os.getloadavg()[0], time.monotonic() - t0), ""]
+    footer = [
+        "## Other benchmarks", "",
+        "- `bench/eval_set.py` and `bench/eval_spread.py`: emaki against EbSynth's CPU build on 13 "
+        "exemplar/target pairs, judged ([design/evaluation.md](design/evaluation.md)); "
+        "`bench/compare_ebsynth.sh`: EbSynth's own StyLit and FaceStyle command lines, wall "
+        "time and peak memory.",
+        "- `bench/temporal_bench`: one layer of a shot run several ways (frame by frame, advection "
+        "guides, confidence, uniformity, warm start, temporal weight), flicker, ghosts, drift and "
+        "the judge ([guide.md](guide.md#reading-qa)).",
+        "- `bench/python_overhead.py` (the module's cost over the command line's synthesis, in "
+        "instructions with `--instructions`) and `bench/python_gil.py` (two Python threads "
+        "synthesizing at once).",
+        "- `bench/farm_bench.sh` (the bundled production through Slurm against `emaki run`) and "
+        "`bench/slurm_overhead.sh` (the scheduler's cost per task, [slurm.md](slurm.md)).",
+        "- Instruction counts, which other jobs do not disturb: `valgrind --tool=callgrind` of "
+        "`emaki synth ... --threads 1` ([design/engine-speed.md](design/engine-speed.md))."]
+    print("\n".join(header + lines + footer).rstrip())
+
+
+if __name__ == "__main__":
+    main()
