@@ -32,12 +32,9 @@ const char* task_kind_name(TaskKind kind) {
   return "?";
 }
 
-namespace {
-
-// Peak resident memory of a task in MB, from the frame size and the exemplars' sizes. The
-// constants are peak RSS per pixel measured with /usr/bin/time on `emaki task` at 160x90,
+// The constants are peak RSS per pixel measured with /usr/bin/time on `emaki task` at 160x90,
 // 480x270 and 960x540 with the StyLit exemplar (docs/farm.md), plus a quarter for margin.
-int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind) {
+int64_t task_memory_mb(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind) {
   const double px = double(s.source.width) * s.source.height;
   const double aa = s.source.kind == pipeline::SourceKind::kScene ? s.source.render.aa : 1;
   double mb = 0;
@@ -62,6 +59,8 @@ int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, TaskKin
   return (with_margin + 63) / 64 * 64;
 }
 
+namespace {
+
 // The exemplars' painting pixels (they dominate a small shot's memory).
 double exemplar_pixels(const pipeline::Shot& s) {
   double px = 0;
@@ -83,6 +82,7 @@ class Planner {
   void add_shot(int index) {
     const PlannedShot& ps = plan_.shots[std::size_t(index)];
     const pipeline::Shot& s = ps.shot;
+    const ScopedMaxPixels budget(shot_max_pixels(s.max_pixels));
     const io::FileStore state(s, io::StoreMode::kRun, io::StoreAccess::kInspect);
     const std::string& out = s.outputs.folder;
     const int first = s.source.first_frame, last = s.source.last_frame;
@@ -170,7 +170,7 @@ class Planner {
     t.threads = o_.threads;
     t.argv.insert(t.argv.end(), {"--threads", std::to_string(o_.threads)});
     t.outputs = std::move(outputs);
-    t.memory_mb = memory_estimate(ps.shot, exemplar_pixels_, kind);
+    t.memory_mb = task_memory_mb(ps.shot, exemplar_pixels_, kind);
     t.done = done;
     for (const std::string& id : after)
       if (!find(id)->done) t.after.push_back(id);

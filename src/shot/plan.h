@@ -54,6 +54,11 @@ struct PlanOptions {
   int threads = 1;              // threads per task (the scheduler's CPUs per task)
 };
 
+// A task's peak resident memory in MB, estimated from the frame size and the exemplars'
+// paintings' pixels (their sum). `emaki run` and the tasks check it before their work
+// (shot/memory.h); a plan gives it to the scheduler.
+int64_t task_memory_mb(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind);
+
 // Plans the shots (each opened and checked by open()). Throws emaki::Error naming the shot file,
 // or the field "chunk" / "threads" for bad options, or "shots" when two shots write one folder.
 Plan plan(const std::vector<std::string>& shot_paths, const PlanOptions& options);
