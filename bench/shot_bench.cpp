@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   }
   if (argc > 2) frames = std::max(2, std::atoi(argv[2]));
   if (argc > 3) threads = std::atoi(argv[3]);
-  set_thread_count(threads);
+  const ScopedThreadCount count(threads);
   try {
     pipeline::Shot shot = shot::open(std::string(EMAKI_SOURCE_DIR) + "/examples/fox/shot.toml");
     shot.source.width = shot.source.render.width = width;

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
     else if (a == "--data")
       dir = argv[i + 1];
   }
-  set_thread_count(threads);
+  const ScopedThreadCount count(threads);
   const char* names[] = {"fullgi", "dirdif", "dirspc", "indirb"};
   Image<float> style = io::read_image_float(dir + "/source_style.png");
   std::vector<Image<float>> src, tgt;

@@ -400,7 +400,7 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
 
 int main(int argc, char** argv) {
   const Options opt = parse(argc, argv);
-  set_thread_count(opt.threads);
+  const ScopedThreadCount count(opt.threads);
   try {
     pipeline::Layer* layer = nullptr;
     pipeline::Shot shot = example(opt, layer);

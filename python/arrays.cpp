@@ -8,6 +8,7 @@
 
 #include "core/limits.h"
 #include "python/errors.h"
+#include "shot/memory.h"
 
 namespace emaki::python {
 namespace {
@@ -44,9 +45,10 @@ SampleType type_of(const py::handle& obj, const py::buffer_info& info, const std
 }
 
 // The array as an ImageView when its layout is one (packed pixels and channels, rows at a
-// positive stride, aligned), else a copy.
+// positive stride, aligned); false otherwise (a copy is needed).
 template <typename T>
-void view_or_copy(ArrayPlane& a, int w, int h, int c) {
+bool view(ArrayPlane& a) {
+  const int w = a.width, h = a.height, c = a.depth;
   const py::buffer_info& info = a.info;
   const auto* base = static_cast<const unsigned char*>(info.ptr);
   const std::ptrdiff_t s = sizeof(T);
@@ -55,10 +57,18 @@ void view_or_copy(ArrayPlane& a, int w, int h, int c) {
   const bool packed = (c == 1 || sc == s) && (w == 1 || sx == c * s);
   const std::ptrdiff_t row = h == 1 ? std::ptrdiff_t(w) * c * s : sy;
   const bool rows_ok = row % s == 0 && row >= std::ptrdiff_t(w) * c * s;
-  if (packed && rows_ok && reinterpret_cast<std::uintptr_t>(base) % s == 0) {
-    a.plane = ImageView<const T>{reinterpret_cast<const T*>(base), w, h, c, row / s};
-    return;
-  }
+  if (!(packed && rows_ok && reinterpret_cast<std::uintptr_t>(base) % s == 0)) return false;
+  a.plane = ImageView<const T>{reinterpret_cast<const T*>(base), w, h, c, row / s};
+  return true;
+}
+
+template <typename T>
+void copy(ArrayPlane& a) {
+  const int w = a.width, h = a.height, c = a.depth;
+  const py::buffer_info& info = a.info;
+  const auto* base = static_cast<const unsigned char*>(info.ptr);
+  const std::ptrdiff_t sy = info.strides[0], sx = info.strides[1];
+  const std::ptrdiff_t sc = a.ndim == 3 ? info.strides[2] : std::ptrdiff_t(sizeof(T));
   Image<T> copy(w, h, c);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
@@ -66,7 +76,12 @@ void view_or_copy(ArrayPlane& a, int w, int h, int c) {
         std::memcpy(&copy(x, y, k), base + y * sy + x * sx + k * sc, sizeof(T));
   a.plane = copy.cview();
   a.copy = std::move(copy);
+  a.needs_copy = false;
   g_input_copies.fetch_add(1, std::memory_order_relaxed);
+}
+
+std::size_t sample_bytes(SampleType t) {
+  return t == SampleType::kU8 ? 1 : t == SampleType::kU16 ? 2 : 4;
 }
 
 }  // namespace
@@ -75,11 +90,12 @@ const void* ArrayPlane::data() const {
   return std::visit([](const auto& v) -> const void* { return v.data; }, plane);
 }
 
-ArrayPlane array_plane(const py::handle& obj, const std::string& name) {
+ArrayPlane inspect_array(const py::handle& obj, const std::string& name) {
   if (!PyObject_CheckBuffer(obj.ptr()))
     raise_input_error(name, fmt::format("expects a numpy array (uint8, uint16 or float32), got {}",
                                         std::string(py::str(obj.get_type().attr("__name__")))));
   ArrayPlane a;
+  a.name = name;
   a.info = py::reinterpret_borrow<py::buffer>(obj).request();
   const py::buffer_info& info = a.info;
   a.type = type_of(obj, info, name);
@@ -94,17 +110,52 @@ ArrayPlane array_plane(const py::handle& obj, const std::string& name) {
     raise_input_error(name, fmt::format("has {} channels (shape {}); at most {}", c,
                                         shape_text(info), kMaxArrayChannels));
   translating(ErrorKind::kInput, {}, [&] { check_pixel_budget(name, w, h); });
+  a.width = int(w), a.height = int(h), a.depth = int(c);
   switch (a.type) {
     case SampleType::kU8:
-      view_or_copy<uint8_t>(a, int(w), int(h), int(c));
+      a.needs_copy = !view<uint8_t>(a);
       break;
     case SampleType::kU16:
-      view_or_copy<uint16_t>(a, int(w), int(h), int(c));
+      a.needs_copy = !view<uint16_t>(a);
       break;
     case SampleType::kF32:
-      view_or_copy<float>(a, int(w), int(h), int(c));
+      a.needs_copy = !view<float>(a);
       break;
   }
+  return a;
+}
+
+void check_copy_memory(const std::vector<const ArrayPlane*>& arrays) {
+  int64_t bytes = 0;
+  std::string first;
+  for (const ArrayPlane* a : arrays) {
+    if (!a->needs_copy) continue;
+    const int64_t row = int64_t(a->width) * a->depth * int64_t(sample_bytes(a->type));
+    bytes += (row + int64_t(kRowAlign) - 1) / int64_t(kRowAlign) * int64_t(kRowAlign) * a->height;
+    if (first.empty()) first = a->name;
+  }
+  if (bytes == 0) return;
+  translating(ErrorKind::kInput, {}, [&] {
+    shot::check_memory(bytes, 0, first, "copying the arrays whose layout cannot be read in place");
+  });
+}
+
+void copy_layout(ArrayPlane& a) {
+  if (!a.needs_copy) return;
+  switch (a.type) {
+    case SampleType::kU8:
+      return copy<uint8_t>(a);
+    case SampleType::kU16:
+      return copy<uint16_t>(a);
+    case SampleType::kF32:
+      return copy<float>(a);
+  }
+}
+
+ArrayPlane array_plane(const py::handle& obj, const std::string& name) {
+  ArrayPlane a = inspect_array(obj, name);
+  check_copy_memory({&a});
+  copy_layout(a);
   return a;
 }
 

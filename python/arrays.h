@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "core/image.h"
 #include "synth/synthesizer.h"
@@ -29,14 +30,31 @@ struct ArrayPlane {
   py::buffer_info info;  // the exported buffer
   std::variant<std::monostate, Image<uint8_t>, Image<uint16_t>, Image<float>> copy;
   SampleType type = SampleType::kF32;
-  int ndim = 3;  // 2: an HxW array; 3: HxWxC
+  int ndim = 3;                          // 2: an HxW array; 3: HxWxC
+  std::string name;                      // the argument, for errors
+  int width = 0, height = 0, depth = 0;  // from the shape (depth: channels)
+  // The layout is not one a view can describe: copy_layout() makes the copy (`plane` is empty
+  // until then).
+  bool needs_copy = false;
   int channels() const { return synth::plane_channels(plane); }
   const void* data() const;  // where the engine reads the samples
 };
 
-// Views `obj` (uint8, uint16 or float32; HxW or HxWxC; any object with the buffer protocol).
-// Raises emaki.InputError naming `name` for another dtype or shape, an empty array or one over
-// the pixel budget.
+// Checks `obj` (uint8, uint16 or float32; HxW or HxWxC; any object with the buffer protocol)
+// and views it in place when its layout allows. Raises emaki.InputError naming `name` for
+// another dtype or shape, an empty array or one over the pixel budget. An array of another
+// layout is not copied yet (needs_copy): a caller with several arrays checks them all, and
+// their sizes against one another, before any copy, so a bad argument never waits on one.
+ArrayPlane inspect_array(const py::handle& obj, const std::string& name);
+
+// Raises emaki.InputError when the copies these arrays need exceed the memory the machine has
+// available (checked before copying: a zero-stride view of gigabytes is a few bytes in Python).
+void check_copy_memory(const std::vector<const ArrayPlane*>& arrays);
+
+// Makes the copy inspect_array left for later (nothing when none is needed).
+void copy_layout(ArrayPlane& a);
+
+// inspect_array, check_copy_memory and copy_layout for one array.
 ArrayPlane array_plane(const py::handle& obj, const std::string& name);
 
 // Layout copies array_plane made in this process (a debugging and testing aid).

@@ -21,11 +21,9 @@ namespace {
 
 // Shot errors name shot-file keys (their own spelling); a Request's neutral fields become the
 // keyword arguments of the call.
-constexpr std::initializer_list<FieldName> kShotArgs = {{"frames", "frames"},
-                                                        {"layers", "layers"},
-                                                        {"layer", "layer"},
-                                                        {"chunk", "chunk"},
-                                                        {"threads", "threads"}};
+constexpr std::initializer_list<FieldName> kShotArgs = {
+    {"frames", "frames"}, {"layers", "layers"},   {"layer", "layer"},
+    {"chunk", "chunk"},   {"threads", "threads"}, {"max_memory", "max_memory_mb"}};
 
 // Thrown out of the pipeline's progress hook to stop a run: Ctrl-C, or the callback raised.
 struct Stop {};
@@ -44,8 +42,9 @@ class PyShot {
   const pipeline::Shot& shot() const { return shot_; }
 
   py::dict run(const py::object& frames, const py::object& layers, bool force, bool previews,
-               const py::object& threads, const py::object& progress) {
-    shot::Request r = request(frames, threads);
+               const py::object& threads, const py::object& progress,
+               const py::object& max_memory_mb) {
+    shot::Request r = request(frames, threads, max_memory_mb);
     r.layers =
         layers.is_none() ? std::vector<std::string>{} : layers.cast<std::vector<std::string>>();
     r.force = force;
@@ -88,8 +87,9 @@ class PyShot {
     return out;
   }
 
-  int composite(const py::object& frames, bool previews, const py::object& threads) {
-    shot::Request r = request(frames, threads);
+  int composite(const py::object& frames, bool previews, const py::object& threads,
+                const py::object& max_memory_mb) {
+    shot::Request r = request(frames, threads, max_memory_mb);
     r.previews = previews;
     return without_gil(ErrorKind::kInput, kShotArgs,
                        [&] { return shot::composite(shot_, r).composited; });
@@ -122,7 +122,8 @@ class PyShot {
   }
 
  private:
-  shot::Request request(const py::object& frames, const py::object& threads) const {
+  shot::Request request(const py::object& frames, const py::object& threads,
+                        const py::object& max_memory_mb = py::none()) const {
     shot::Request r;
     if (py::isinstance<py::int_>(frames)) {
       r.first_frame = r.last_frame = frames.cast<int>();
@@ -135,6 +136,11 @@ class PyShot {
     if (!threads.is_none()) {
       r.threads = threads.cast<int>();
       if (r.threads < 0 || r.threads > 1024) raise_input_error("threads", "must be in [0, 1024]");
+    }
+    if (!max_memory_mb.is_none()) {
+      r.max_memory_mb = max_memory_mb.cast<int64_t>();
+      if (r.max_memory_mb < 1 || r.max_memory_mb > (int64_t(1) << 40))
+        raise_input_error("max_memory_mb", "must be in [1, 2**40] (MB) or None");
     }
     return r;
   }
@@ -238,8 +244,9 @@ void bind_shot(py::module_& m) {
       .def("run", &PyShot::run, py::kw_only(), py::arg("frames") = py::none(),
            py::arg("layers") = py::none(), py::arg("force") = false, py::arg("previews") = true,
            py::arg("threads") = py::none(), py::arg("progress") = py::none(),
+           py::arg("max_memory_mb") = py::none(),
            "run(*, frames=None, layers=None, force=False, previews=True, threads=None, "
-           "progress=None) -> dict\n\n"
+           "progress=None, max_memory_mb=None) -> dict\n\n"
            "Synthesizes every layer of the requested frames (with the temporal chain), composites "
            "them and writes the shot's outputs; resumes after the last finished frame.\n"
            "frames: None (all), a frame, or (first, last) inclusive, within the shot's frames.\n"
@@ -247,11 +254,14 @@ void bind_shot(py::module_& m) {
            "previews: write the contact sheet and MP4.  threads: None (the shot's), 0 = all "
            "cores, [0, 1024].\nprogress: called with {frame, layer, done, total, elapsed} before "
            "each layer-frame (layer None: compositing); raising from it stops the run.\n"
+           "max_memory_mb: refuse to start when the estimated peak memory exceeds it (what the "
+           "machine has available is always checked).\n"
            "The GIL is released while it runs; Ctrl-C stops it after the current layer-frame.\n"
            "Returns {synthesized, reused, composited, frames, previews}.")
       .def("composite", &PyShot::composite, py::kw_only(), py::arg("frames") = py::none(),
            py::arg("previews") = true, py::arg("threads") = py::none(),
-           "composite(*, frames=None, previews=True, threads=None) -> int\n\n"
+           py::arg("max_memory_mb") = py::none(),
+           "composite(*, frames=None, previews=True, threads=None, max_memory_mb=None) -> int\n\n"
            "Re-composites finished layers with the shot's colours, blends and paper; returns the "
            "frames written.")
       .def("flicker", &PyShot::flicker, py::arg("layer"), py::kw_only(),

@@ -129,10 +129,29 @@ std::vector<GuideArrays> guide_arrays(const py::sequence& guides) {
         raise_input_error(name + "[2]", "the weight must be a number or None");
       }
     }
-    out.push_back({array_plane(pair[0], name + "[0]"), array_plane(pair[1], name + "[1]"),
+    out.push_back({inspect_array(pair[0], name + "[0]"), inspect_array(pair[1], name + "[1]"),
                    checked_weight(w, name + "[2]")});
   }
   return out;
+}
+
+// Sizes first, then the memory any layout copy needs, then the copies: a bad argument is refused
+// before a large copy (a zero-stride view of gigabytes is a few bytes in Python).
+void copy_layouts_after_checks(ArrayPlane& style, std::vector<GuideArrays>& guides,
+                               std::optional<ArrayPlane>& mask) {
+  auto size = [](const ArrayPlane& a) { return synth::NamedSize{a.name, a.width, a.height}; };
+  std::vector<std::pair<synth::NamedSize, synth::NamedSize>> sizes;
+  std::vector<const ArrayPlane*> all{&style};
+  for (const GuideArrays& g : guides) {
+    sizes.emplace_back(size(g.source), size(g.target));
+    all.insert(all.end(), {&g.source, &g.target});
+  }
+  if (mask) all.push_back(&*mask);
+  translating(ErrorKind::kInput, {}, [&] { synth::check_guide_sizes(size(style), sizes); });
+  check_copy_memory(all);
+  copy_layout(style);
+  for (GuideArrays& g : guides) copy_layout(g.source), copy_layout(g.target);
+  if (mask) copy_layout(*mask);
 }
 
 uint64_t checked_seed(const py::object& seed) {
@@ -234,10 +253,11 @@ py::object synthesize(const py::handle& style_obj, const py::sequence& guides_ob
   if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
     raise_input_error("progress", "must be callable(level, levels) or None");
 
-  const ArrayPlane style = array_plane(style_obj, "style");
-  const std::vector<GuideArrays> guides = guide_arrays(guides_obj);
+  ArrayPlane style = inspect_array(style_obj, "style");
+  std::vector<GuideArrays> guides = guide_arrays(guides_obj);
   std::optional<ArrayPlane> mask;
-  if (!mask_obj.is_none()) mask = array_plane(mask_obj, "mask");
+  if (!mask_obj.is_none()) mask = inspect_array(mask_obj, "mask");
+  copy_layouts_after_checks(style, guides, mask);
   const SampleType out_type = sample_type(dtype, "dtype", style.type);
   synth::OutputRequest request;
   request.nnf = nnf;

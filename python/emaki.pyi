@@ -148,6 +148,7 @@ class Shot:
         previews: bool = True,
         threads: Optional[int] = None,
         progress: Optional[Callable[[dict], object]] = None,
+        max_memory_mb: Optional[int] = None,
     ) -> dict: ...
     def composite(
         self,
@@ -155,6 +156,7 @@ class Shot:
         frames: Union[None, int, Tuple[int, int]] = None,
         previews: bool = True,
         threads: Optional[int] = None,
+        max_memory_mb: Optional[int] = None,
     ) -> int: ...
     def flicker(self, layer: str, *, frames: Union[None, int, Tuple[int, int]] = None) -> dict: ...
     def plan(self, *, chunk: int = 8, threads: int = 1, emaki: str = "emaki") -> dict: ...

@@ -35,6 +35,15 @@ for _cls in (Error, InputError, FileError):
     _cls.__module__ = "emaki"
 )";
 
+// A message, subject or path as a Python str: bytes that are not UTF-8 (a path from a Latin-1
+// file system, a value cut by echo) become U+FFFD rather than a UnicodeDecodeError that would
+// hide the error itself.
+py::str text(const std::string& s) {
+  PyObject* o = PyUnicode_DecodeUTF8(s.data(), Py_ssize_t(s.size()), "replace");
+  if (!o) throw py::error_already_set();
+  return py::reinterpret_steal<py::str>(o);
+}
+
 }  // namespace
 
 void bind_errors(py::module_& m) {
@@ -53,12 +62,12 @@ void raise_error(const Error& e, ErrorKind kind, std::initializer_list<FieldName
     if (e.field() == f.field) subject = f.argument;
   const Error named = is_field ? e.respelled(subject) : e;
   PyObject* cls = kind == ErrorKind::kFile && !is_field ? g_file_error : g_input_error;
-  py::object instance =
-      py::reinterpret_steal<py::object>(PyObject_CallFunction(cls, "s", named.what()));
+  py::object instance = py::reinterpret_steal<py::object>(
+      PyObject_CallFunctionObjArgs(cls, text(named.what()).ptr(), nullptr));
   if (!instance) throw py::error_already_set();
-  instance.attr("subject") = subject;
-  instance.attr("message") = e.message();
-  if (cls == g_file_error) instance.attr("filename") = subject;
+  instance.attr("subject") = text(subject);
+  instance.attr("message") = text(e.message());
+  if (cls == g_file_error) instance.attr("filename") = text(subject);
   PyErr_SetObject(cls, instance.ptr());
   throw py::error_already_set();
 }

@@ -250,6 +250,38 @@ TEST_F(HostileShot, CommandLineMaxPixelsOverridesTheShots) {
                   {"--max-pixels", "100"});
 }
 
+// One shot's budget governs that shot only: `emaki plan a.toml b.toml` plans b under the default.
+TEST_F(HostileShot, OneShotsMaxPixelsDoesNotGovernTheNext) {
+  // 1.2 M pixels: a's 64x48 frames and 1200x912 painting fit; b's 1200x1100 frames do not.
+  write("a.toml", shot_text({{"TOP", "[limits]\nmax_pixels = 1200000"}}));
+  write("b.toml", std::regex_replace(shot_text({{"SIZE", "size = [1200, 1100]"}}),
+                                     std::regex("folder = \"out\""), "folder = \"out_b\""));
+  const CliResult r = emaki({"plan", "a.toml", "b.toml"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.signal, 0);
+}
+
+// ---- 10. memory: the estimated peak is checked before any work ----
+
+TEST_F(HostileShot, AShotTooLargeForTheMachineIsRefusedAtOnce) {
+  // 16384x16384 is within the pixel budget; its layer task needs ~100 GB.
+  expect_bad_shot(shot_text({{"SIZE", "size = [16384, 16384]"}}), "shot.toml");
+  write("shot.toml", shot_text({{"SIZE", "size = [16384, 16384]"}}));
+  const CliResult r = emaki({"run", "shot.toml"});
+  EXPECT_NE(r.err.find("16384x16384 frames needs about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("GB of memory"), std::string::npos) << r.err;
+}
+
+TEST_F(HostileShot, MaxMemoryIsALimitOfItsOwn) {
+  expect_bad_shot(shot_text({}), "--max-memory", {"--max-memory", "64"});
+  for (const char* bad : {"0", "-5", "8X", "G", "+8", "99999999999999999999"})
+    expect_bad_shot(shot_text({}), "--max-memory", {"--max-memory", bad});
+  for (const char* task : {"prepare", "composite"}) {
+    write("shot.toml", shot_text({}));
+    expect_refused(emaki({"task", task, "shot.toml", "--max-memory", "1"}), "task", "--max-memory");
+  }
+}
+
 // ---- 4. size and depth before toml++ parses ----
 
 TEST_F(HostileShot, HugeAndDeepFilesAreRefusedBeforeParsing) {

@@ -185,7 +185,7 @@ int run_task(const Args& args) {
   r.farm_task = true;
   r.previews = false;
   if (kind == "prepare") {
-    shot::prepare(shot);
+    shot::prepare(shot, r);
   } else if (kind == "passes") {
     const int n = shot::render_passes(shot, r);
     std::fprintf(stderr, "emaki task: %d frames of passes rendered\n", n);

@@ -14,6 +14,7 @@
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/parallel.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
 #include "render/passes.h"
@@ -131,6 +132,7 @@ int run_render(const Args& args) {
   RenderCommandOptions o;
   add_options(app, o);
   if (parse_cli(app, args)) return 0;
+  const ScopedThreadCount threads(o.shot.threads);
   render::RenderOptions options;
   const scene::ShotSpec shot = resolve_shot(o, options);
 

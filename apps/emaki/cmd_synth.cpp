@@ -165,7 +165,7 @@ int run_synth(const Args& argv) {
   check_output_path("-output", args.output);
   if (!args.nnf_out.empty()) check_output_path("--nnf-out", args.nnf_out);
   if (!args.error_out.empty()) check_output_path("--error-out", args.error_out);
-  set_thread_count(args.threads);
+  const ScopedThreadCount threads(args.threads);
 
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<io::AnyImage> files = read_files(args);

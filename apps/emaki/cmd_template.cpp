@@ -10,6 +10,7 @@
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_options.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "exemplar/reference_sphere.h"
 #include "io/image_io.h"
 #include "render/renderer.h"
@@ -79,6 +80,7 @@ int run_template(const Args& args) {
   TemplateOptions o;
   add_options(app, o);
   if (parse_cli(app, args)) return 0;
+  const ScopedThreadCount threads(o.shot.threads);
   render::RenderOptions options;
   const exemplar::ReferenceSpec spec = reference_spec(o, app.count("--horizon") > 0, options);
   const scene::Scene sphere_scene = exemplar::sphere_scene();

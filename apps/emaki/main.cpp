@@ -40,11 +40,13 @@ struct FieldOption {
   const char* option;
 };
 constexpr FieldOption kFieldOptions[] = {
-    {"frames", "--frames"}, {"fps", "--fps"},         {"clip", "--clip"},
-    {"start", "--start"},   {"aa", "--aa"},           {"gltf_node", "--gltf-camera"},
-    {"sphere", "--sphere"}, {"horizon", "--horizon"}, {"layers", "--layers"},
-    {"layer", "--layer"},   {"chunk", "--chunk"},     {"threads", "--threads"},
-    {"shots", "SHOT"},
+    {"frames", "--frames"}, {"fps", "--fps"},
+    {"clip", "--clip"},     {"start", "--start"},
+    {"aa", "--aa"},         {"gltf_node", "--gltf-camera"},
+    {"sphere", "--sphere"}, {"horizon", "--horizon"},
+    {"layers", "--layers"}, {"layer", "--layer"},
+    {"chunk", "--chunk"},   {"threads", "--threads"},
+    {"shots", "SHOT"},      {"max_memory", "--max-memory"},
 };
 
 // An emaki::Error naming a field is re-spelled as its option; anything else reads as it is.

@@ -3,10 +3,13 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "apps/emaki/frame_range.h"
+#include "core/error.h"
+#include "core/limits.h"
 
 namespace emaki::app {
 
@@ -19,6 +22,22 @@ std::vector<std::string> split_commas(const std::string& text) {
     start = end + 1;
   }
   return out;
+}
+
+int64_t parse_memory_mb(const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  long long n = -1;
+  try {
+    n = std::stoll(text, &used);
+  } catch (const std::exception&) {
+  }
+  const std::string unit = text.substr(std::min(used, text.size()));
+  const int shift = unit.empty() || unit == "M" ? 0 : unit == "G" ? 10 : unit == "T" ? 20 : -1;
+  // At most 2^40 MB: the figure in bytes must fit an int64.
+  if (n < 1 || shift < 0 || text[0] == '+' || n > (int64_t(1) << (40 - std::max(shift, 0))))
+    throw Error(option, fmt::format("expected a size in MB, or with M, G or T (e.g. 8G), got '{}'",
+                                    echo(text)));
+  return int64_t(n) << shift;
 }
 
 namespace {
@@ -61,6 +80,9 @@ void ShotCommand::bind(CLI::App& app, const char* frames_help) {
   app.add_option("--frames", frames, frames_help);
   app.add_option("--threads", threads, "worker threads, >= 0; 0 = all cores (default: the shot's)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-memory", max_memory,
+                 "refuse to start when the estimated peak memory exceeds this: MB, or a number "
+                 "with M, G or T (e.g. 8G); what the machine has available is always checked");
 }
 
 void ShotCommand::bind_previews(CLI::App& app) {
@@ -77,6 +99,7 @@ shot::Request ShotCommand::request(const char* command) const {
   r.layers = split_commas(layers);
   r.previews = !no_previews;
   r.threads = threads;
+  if (!max_memory.empty()) r.max_memory_mb = parse_memory_mb("--max-memory", max_memory);
   r.progress = progress_printer(command);
   return r;
 }

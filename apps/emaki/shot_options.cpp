@@ -10,7 +10,6 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/limits.h"
-#include "core/parallel.h"
 #include "io/image_io.h"
 #include "render/passes.h"
 
@@ -319,7 +318,6 @@ void ShotOptions::resolve_shot(scene::ShotSpec& shot, render::RenderOptions& opt
   }
   shot.ground.color = vec3("--ground-color", ground_color);
   shot.background = vec3("--background", background);
-  set_thread_count(threads);
 }
 
 void make_output_dir(const std::string& option, const std::filesystem::path& dir) {

@@ -28,21 +28,49 @@ inline std::atomic<bool>& max_pixels_pinned_slot() {
   static std::atomic<bool> v{false};
   return v;
 }
+// This thread's ScopedMaxPixels budget; 0: none lives.
+inline thread_local int64_t t_max_pixels = 0;
 }  // namespace detail
 
-// The process-wide pixel budget (`--max-pixels` on the CLI, `limits.max_pixels` in a shot).
+// The pixel budget of the work on this thread: the innermost ScopedMaxPixels's, else the
+// process's (`--max-pixels` on the CLI, else kDefaultMaxPixels).
 inline int64_t max_pixels() {
-  return detail::max_pixels_slot().load(std::memory_order_relaxed);
+  const int64_t scoped = detail::t_max_pixels;
+  return scoped > 0 ? scoped : detail::max_pixels_slot().load(std::memory_order_relaxed);
 }
-// Sets the budget and pins it: the command line's --max-pixels wins over a shot file's.
+// This thread's ScopedMaxPixels budget, 0 when none lives (parallel_for hands it to workers).
+inline int64_t scoped_max_pixels() {
+  return detail::t_max_pixels;
+}
+// Sets the process's budget and pins it: the command line's --max-pixels, set before any work,
+// wins over every shot file's limits.max_pixels.
 inline void set_max_pixels(int64_t n) {
   detail::max_pixels_slot().store(n, std::memory_order_relaxed);
   detail::max_pixels_pinned_slot().store(true, std::memory_order_relaxed);
 }
-// A file's budget (a shot's `limits.max_pixels`): applies unless set_max_pixels pinned one.
-inline void set_max_pixels_from_file(int64_t n) {
-  if (!detail::max_pixels_pinned_slot().load(std::memory_order_relaxed))
-    detail::max_pixels_slot().store(n, std::memory_order_relaxed);
+
+// While it lives, max_pixels() on the constructing thread (and in the parallel_for calls it
+// makes) is `n` (0: unchanged). A shot's `limits.max_pixels` is applied this way for the
+// duration of that shot's parsing and work, so it never reaches another shot or another call.
+class ScopedMaxPixels {
+ public:
+  explicit ScopedMaxPixels(int64_t n) : previous_(detail::t_max_pixels) {
+    if (n > 0) detail::t_max_pixels = n;
+  }
+  ~ScopedMaxPixels() { detail::t_max_pixels = previous_; }
+  ScopedMaxPixels(const ScopedMaxPixels&) = delete;
+  ScopedMaxPixels& operator=(const ScopedMaxPixels&) = delete;
+
+ private:
+  int64_t previous_;
+};
+
+// The budget a shot's work runs under: the pinned --max-pixels, else the shot file's
+// `limits.max_pixels` (`from_file`, 0 when the file sets none), else the process's.
+inline int64_t shot_max_pixels(int64_t from_file) {
+  if (detail::max_pixels_pinned_slot().load(std::memory_order_relaxed) || from_file <= 0)
+    return detail::max_pixels_slot().load(std::memory_order_relaxed);
+  return from_file;
 }
 
 // Frame numbers and counts from a shot file or an option (documented in docs/shot_file.md):
@@ -66,11 +94,22 @@ std::optional<T> checked_add(T a, T b) {
   return r;
 }
 
-// A user value shown in an error line, cut to `cap` bytes: a 100 MB clip name must not be
-// echoed whole. Control characters are shown as '?'.
+// The length of `value`'s longest prefix of at most `cap` bytes that does not split a UTF-8
+// character: error lines must stay valid UTF-8 (Python's str, JSON).
+inline std::size_t utf8_prefix(std::string_view value, std::size_t cap) {
+  if (value.size() <= cap) return value.size();
+  std::size_t n = cap;
+  for (int back = 0; back < 3 && n > 0 && (static_cast<unsigned char>(value[n]) & 0xC0) == 0x80;
+       ++back)
+    --n;
+  return n;
+}
+
+// A user value shown in an error line, cut to `cap` bytes at a character boundary: a 100 MB clip
+// name must not be echoed whole. Control characters are shown as '?'.
 inline std::string echo(std::string_view value, std::size_t cap = 80) {
   std::string out;
-  const std::size_t n = value.size() < cap ? value.size() : cap;
+  const std::size_t n = utf8_prefix(value, cap);
   out.reserve(n + 16);
   for (std::size_t i = 0; i < n; ++i) {
     const unsigned char c = static_cast<unsigned char>(value[i]);
@@ -82,12 +121,15 @@ inline std::string echo(std::string_view value, std::size_t cap = 80) {
 
 // A file or folder path in an error line: whole up to 400 bytes (studio paths run past 80 and
 // the file name at the end is what the user needs); a longer one keeps its first 100 and last
-// 280 bytes around "...(N bytes)...", so the line stays short and still ends in the file name.
+// 280 bytes (fewer where a character would be split) around "...(N bytes)...", so the line stays
+// short and still ends in the file name.
 inline std::string echo_path(std::string_view path) {
   constexpr std::size_t kWhole = 400, kHead = 100, kTail = 280;
   if (path.size() <= kWhole) return echo(path, kWhole);
-  return echo(path.substr(0, kHead), kHead) + "...(" + std::to_string(path.size()) + " bytes)..." +
-         echo(path.substr(path.size() - kTail), kTail);
+  std::size_t tail = path.size() - kTail;
+  for (int on = 0; on < 3 && (static_cast<unsigned char>(path[tail]) & 0xC0) == 0x80; ++on) ++tail;
+  return echo(path.substr(0, utf8_prefix(path, kHead)), kHead) + "...(" +
+         std::to_string(path.size()) + " bytes)..." + echo(path.substr(tail), kTail);
 }
 
 // Throws Error(subject) when width x height is not a positive size within the pixel budget.

@@ -12,16 +12,15 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
+
+#include "core/limits.h"
 
 namespace emaki {
 namespace {
-std::mutex g_mutex;
-int g_threads = 0;
-std::unique_ptr<tbb::task_arena> g_arena;
 // This thread's ScopedThreadCount, if any.
 thread_local ScopedThreadCount::Arena* t_arena = nullptr;
-
 }  // namespace
 
 struct ScopedThreadCount::Arena {
@@ -31,25 +30,51 @@ struct ScopedThreadCount::Arena {
 
 namespace {
 
-tbb::task_arena& arena() {
-  if (t_arena) return t_arena->arena;
-  std::lock_guard lock(g_mutex);
-  // Without this, TBB sizes its worker pool by the first arena it sees: a first run with one
-  // thread would cap every later run at one. Allowing plenty lets each arena get what it asks.
+// Without this, TBB sizes its worker pool by the first arena it sees: a first run with one
+// thread would cap every later run at one. Allowing plenty lets each arena get what it asks.
+void allow_parallelism() {
   static tbb::global_control allow(
       tbb::global_control::max_allowed_parallelism,
       std::max<std::size_t>(64, tbb::this_task_arena::max_concurrency()));
-  if (!g_arena) {
-    const int n = g_threads > 0 ? g_threads : tbb::this_task_arena::max_concurrency();
-    g_arena = std::make_unique<tbb::task_arena>(n);
-  }
-  return *g_arena;
 }
+
+// The arena of calls outside any ScopedThreadCount: all hardware threads. Made once and never
+// reset, so no thread can find the arena it runs in destroyed under it.
+tbb::task_arena& default_arena() {
+  static tbb::task_arena* const a = [] {
+    allow_parallelism();
+    return new tbb::task_arena(tbb::this_task_arena::max_concurrency());
+  }();
+  return *a;
+}
+
+tbb::task_arena& arena() {
+  return t_arena ? t_arena->arena : default_arena();
+}
+
+// Runs a chunk, on whichever thread, under the settings of the thread that called parallel_for:
+// its arena (a nested parallel_for keeps the caller's thread count) and its pixel budget.
+struct CallersChunk {
+  const std::function<void(int64_t, int64_t)>& fn;
+  ScopedThreadCount::Arena* arena;
+  int64_t budget;
+  void operator()(int64_t a, int64_t b) const {
+    ScopedThreadCount::Arena* const previous = std::exchange(t_arena, arena);
+    const ScopedMaxPixels scope(budget);
+    try {
+      fn(a, b);
+    } catch (...) {
+      t_arena = previous;
+      throw;
+    }
+    t_arena = previous;
+  }
+};
 }  // namespace
 
 ScopedThreadCount::ScopedThreadCount(int n) : previous_(t_arena) {
   if (n <= 0) return;
-  arena();  // sets TBB's global parallelism limit before the first arena is made
+  allow_parallelism();  // before the first arena is made
   arena_ = std::make_unique<Arena>(n);
   t_arena = arena_.get();
 }
@@ -58,18 +83,13 @@ ScopedThreadCount::~ScopedThreadCount() {
   t_arena = previous_;
 }
 
-void set_thread_count(int n) {
-  std::lock_guard lock(g_mutex);
-  g_threads = std::max(0, n);
-  g_arena.reset();
-}
-
 int thread_count() {
   return arena().max_concurrency();
 }
 
-void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn) {
+void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& body) {
   if (n <= 0) return;
+  const CallersChunk fn{body, t_arena, scoped_max_pixels()};
   grain = std::max<int64_t>(1, grain);
   const int64_t chunks = (n + grain - 1) / grain;
   if (chunks == 1) {

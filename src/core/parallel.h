@@ -8,14 +8,13 @@
 
 namespace emaki {
 
-// Sets the number of worker threads used by parallel_for (0 = all hardware threads).
-void set_thread_count(int n);
+// The number of threads parallel_for calls made on this thread may use.
 int thread_count();
 
 // While it lives, parallel_for calls made on the constructing thread use at most `n` threads
-// (0: the process-wide setting), leaving the process-wide setting alone: callers on different
-// threads (Python threads, each with its own `threads` argument) never disturb one another.
-// set_thread_count, by contrast, must not run while another thread is inside parallel_for.
+// (0: the enclosing ScopedThreadCount's count, else all hardware threads). Each one has its own
+// task arena and nothing process-wide is ever reset, so callers on different threads (Python
+// threads, two shots run at once, each with its own thread count) never disturb one another.
 class ScopedThreadCount {
  public:
   explicit ScopedThreadCount(int n);
@@ -30,7 +29,8 @@ class ScopedThreadCount {
   Arena* previous_ = nullptr;
 };
 
-// Calls fn(begin, end) over [0, n) in chunks of `grain` items, in parallel.
+// Calls fn(begin, end) over [0, n) in chunks of `grain` items, in parallel. The calling thread's
+// pixel budget (core/limits.h) holds inside fn on every worker thread.
 void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn);
 
 // Calls fn(y0, y1) over row bands of `band` rows.

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/gltf_internal.h"
+#include "io/input_file.h"
 
 namespace emaki::io {
 
@@ -209,8 +210,9 @@ fs::path canonical_folder(const fs::path& dir) {
 }  // namespace
 
 Scene load_gltf(const std::string& path, const GltfOptions& options) {
+  if (const std::string problem = input_file_problem(path); !problem.empty())
+    throw Error(path, problem);
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw Error(path, "no such file");
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) throw Error(path, "cannot be read");
   if (size > uint64_t(kMaxFileBytes))

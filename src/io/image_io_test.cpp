@@ -92,13 +92,12 @@ TEST_F(ImageIo, PngInManyStripsRoundTripsAndIgnoresThreadCount) {
       o.format = sixteen ? SampleFormat::kU16 : SampleFormat::kU8;
       std::string first;
       for (int threads : {1, 2, 3}) {
-        set_thread_count(threads);
+        const ScopedThreadCount count(threads);
         write_image(p("s.png"), im.cview(), o);
         const std::string bytes = file_bytes(p("s.png"));
         if (first.empty()) first = bytes;
         EXPECT_EQ(bytes, first) << threads << " threads";
       }
-      set_thread_count(0);
       const AnyImage back = read_image(p("s.png"));
       ASSERT_EQ(back.channels(), c);
       ASSERT_EQ(back.width(), 300);

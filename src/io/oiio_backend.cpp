@@ -242,8 +242,9 @@ std::string guarded(F&& f) {
 
 std::string read_impl(const OiioSource& source, const ReadOptions& options, int64_t max_pixels,
                       AnyImage& result) {
-  // This module may hold its own copy of the budget (see OiioBackend): make it the caller's.
-  set_max_pixels(max_pixels);
+  // This module may hold its own copy of the budget (see OiioBackend): make it the caller's, for
+  // this call only (a shot's budget must not outlive its work).
+  const ScopedMaxPixels budget(max_pixels);
   return guarded([&] { return read_checked(source, options, result); });
 }
 

@@ -185,6 +185,7 @@ struct Shot {
   Compositing compositing;
   Outputs outputs;
   int threads = 0;
+  int64_t max_pixels = 0;  // limits.max_pixels; 0: none given (the process's budget applies)
 
   const Exemplar* find_exemplar(const std::string& name) const {
     for (const Exemplar& e : exemplars)

@@ -170,11 +170,12 @@ TEST(Render, ResultDoesNotDependOnThreadCount) {
   options.width = 200;
   options.height = 120;
   const ShotRenderer r(s, shot, options);
-  set_thread_count(1);
-  const Image<float> a = r.render(2);
-  set_thread_count(2);
-  const Image<float> b = r.render(2);
-  set_thread_count(0);
+  const auto render_with = [&](int threads) {
+    const ScopedThreadCount count(threads);
+    return r.render(2);
+  };
+  const Image<float> a = render_with(1);
+  const Image<float> b = render_with(2);
   ASSERT_EQ(a.bytes(), b.bytes());
   EXPECT_EQ(std::memcmp(a.row(0), b.row(0), a.bytes()), 0);
 }

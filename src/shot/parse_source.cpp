@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "io/image_io.h"
+#include "io/input_file.h"
 #include "render/passes.h"
 #include "shot/parse.h"
 #include "store/frame_sequence.h"
@@ -189,10 +190,8 @@ void parse_channel_mapping(const Reader& r, pipeline::Source& s) {
 // The first frame must exist and carry every pass the pipeline may read; it gives the size.
 // Returns the channel holding coverage (alpha).
 std::string check_first_frame(const Reader& r, pipeline::Source& s, const std::string& first) {
-  std::error_code ec;
-  if (!fs::is_regular_file(first, ec))
-    throw Error(r.key_path("sequence"),
-                fmt::format("no such file '{}' (frame {})", echo_path(first), s.first_frame));
+  if (const std::string problem = io::input_file_problem(first, echo_path(first)); !problem.empty())
+    throw Error(r.key_path("sequence"), fmt::format("{} (frame {})", problem, s.first_frame));
   const std::vector<std::string> have = io::list_channels(first);
   auto has = [&](const std::string& ch) {
     return std::find(have.begin(), have.end(), ch) != have.end();

@@ -62,11 +62,13 @@ SceneCost scene_cost(const pipeline::Shot& s) {
   return cost;
 }
 
+}  // namespace
+
 // Peak resident memory of a task in MB, from the frame size, the exemplars' sizes and the scene.
 // The constants are peak RSS per pixel measured with /usr/bin/time on `emaki task` at 160x90,
 // 480x270 and 960x540 with the StyLit exemplar (docs/farm.md), plus a quarter for margin.
-int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, const SceneCost& scene,
-                        TaskKind kind) {
+int64_t task_memory_mb(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind,
+                       const SceneCost& scene) {
   const double px = double(s.source.width) * s.source.height;
   const double aa = s.source.kind == pipeline::SourceKind::kScene ? s.source.render.aa : 1;
   double mb = 0;
@@ -91,6 +93,8 @@ int64_t memory_estimate(const pipeline::Shot& s, double exemplar_pixels, const S
   const int64_t with_margin = int64_t(mb * 1.25) + 1;
   return (with_margin + 63) / 64 * 64;
 }
+
+namespace {
 
 // The exemplars' painting pixels (they dominate a small shot's memory).
 double exemplar_pixels(const pipeline::Shot& s) {
@@ -126,6 +130,7 @@ class Planner {
   void add_shot(int index) {
     const PlannedShot& ps = plan_.shots[std::size_t(index)];
     const pipeline::Shot& s = ps.shot;
+    const ScopedMaxPixels budget(shot_max_pixels(s.max_pixels));
     const io::FileStore state(s, io::StoreMode::kRun, io::StoreAccess::kInspect);
     const std::string& out = s.outputs.folder;
     const int first = s.source.first_frame, last = s.source.last_frame;
@@ -236,7 +241,7 @@ class Planner {
     t.threads = o_.threads;
     t.argv.insert(t.argv.end(), {"--threads", std::to_string(o_.threads)});
     t.outputs = std::move(outputs);
-    t.memory_mb = memory_estimate(ps.shot, exemplar_pixels_, scene_, kind);
+    t.memory_mb = task_memory_mb(ps.shot, exemplar_pixels_, kind, scene_);
     t.done = done;
     for (const std::string& id : after)
       if (!done_.at(id)) t.after.push_back(id);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "pipeline/shot.h"
+#include "shot/objects.h"
 
 namespace emaki::shot {
 
@@ -53,6 +54,13 @@ struct PlanOptions {
   int chunk = 8;                // frames per passes / layer / composite chunk, >= 1
   int threads = 1;              // threads per task (the scheduler's CPUs per task)
 };
+
+// A task's peak resident memory in MB, estimated from the frame size and the exemplars'
+// paintings' pixels (their sum). `emaki run` and the tasks check it before their work
+// (shot/memory.h); a plan gives it to the scheduler.
+// `scene`: what the shot's scene holds (shot/objects.h; empty for studio passes).
+int64_t task_memory_mb(const pipeline::Shot& s, double exemplar_pixels, TaskKind kind,
+                       const SceneCost& scene = {});
 
 // Plans the shots (each opened and checked by open()). Throws emaki::Error naming the shot file,
 // or the field "chunk" / "threads" for bad options, or "shots" when two shots write one folder.

@@ -6,6 +6,8 @@
 #include "core/limits.h"
 #include "core/parallel.h"
 #include "shot/inputs.h"
+#include "shot/memory.h"
+#include "shot/plan.h"
 #include "shot/shot_file.h"
 #include "store/file_store.h"
 #include "store/previews.h"
@@ -18,8 +20,42 @@ const pipeline::RunOptions& run_options(const Request& r) {
   return r;
 }
 
-void use_threads(const pipeline::Shot& shot, const Request& r) {
-  set_thread_count(r.threads >= 0 ? r.threads : shot.threads);
+// What one call's work runs under, on this thread only: its thread count and the shot's pixel
+// budget. Nothing process-wide changes, so shots run at once on different threads (Python
+// threads) keep their own settings.
+struct Scope {
+  ScopedThreadCount threads;
+  ScopedMaxPixels pixels;
+  Scope(const pipeline::Shot& shot, const Request& r)
+      : threads(r.threads >= 0 ? r.threads : shot.threads),
+        pixels(shot_max_pixels(shot.max_pixels)) {}
+  explicit Scope(const pipeline::Shot& shot) : Scope(shot, Request{}) {}
+};
+
+using Exemplars = std::map<std::string, pipeline::ExemplarImages>;
+
+// Refuses work whose estimated peak memory (the planner's figure for the largest kind of task
+// it does) exceeds the request's max_memory_mb or what the machine has available, before the
+// work starts. `exemplars`: the paintings, for the kinds whose peak depends on them.
+void check_peak_memory(const pipeline::Shot& shot, const Request& r, const char* work,
+                       std::initializer_list<TaskKind> kinds, const Exemplars& exemplars = {}) {
+  double painting_pixels = 0;
+  for (const auto& [name, e] : exemplars)
+    painting_pixels += double(e.painting.width()) * e.painting.height();
+  int64_t mb = 0;
+  for (TaskKind k : kinds) mb = std::max(mb, task_memory_mb(shot, painting_pixels, k));
+  check_memory(mb << 20, r.max_memory_mb << 20, shot.path,
+               fmt::format("{} of {}x{} frames", work, shot.source.width, shot.source.height));
+}
+
+// The exemplars, loaded between two memory checks: the frames' share alone first, so a shot far
+// too large is refused before its paintings are read, then with the paintings.
+Exemplars load_exemplars_checked(const pipeline::Shot& shot, const Request& r, const char* work,
+                                 std::initializer_list<TaskKind> kinds) {
+  check_peak_memory(shot, r, work, kinds);
+  Exemplars exemplars = load_exemplars(shot);
+  check_peak_memory(shot, r, work, kinds, exemplars);
+  return exemplars;
 }
 
 io::StoreAccess access(const Request& r) {
@@ -43,10 +79,13 @@ pipeline::Shot open_text(std::string_view text, const std::string& path) {
 
 RunResult run(const pipeline::Shot& shot, const Request& request) {
   pipeline::check_run_options(shot, run_options(request));
-  use_threads(shot, request);
+  const Scope scope(shot, request);
   // Everything that can fail on the inputs fails here, before a single output file exists.
+  const auto exemplars = load_exemplars_checked(
+      shot, request, request.composite ? "the run" : "the layer task",
+      {TaskKind::kLayer, request.composite ? TaskKind::kComposite : TaskKind::kLayer,
+       TaskKind::kPasses});
   const auto frames = open_frames(shot);
-  const auto exemplars = load_exemplars(shot);
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);
   const pipeline::WeightMapImages maps = load_weight_maps(shot);
   RunResult out;
@@ -58,7 +97,8 @@ RunResult run(const pipeline::Shot& shot, const Request& request) {
 
 CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
   pipeline::check_run_options(shot, run_options(request));
-  use_threads(shot, request);
+  const Scope scope(shot, request);
+  check_peak_memory(shot, request, "compositing", {TaskKind::kComposite});
   const auto frames = open_frames(shot);
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);
   CompositeResult out;
@@ -69,10 +109,11 @@ CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
   return out;
 }
 
-void prepare(const pipeline::Shot& shot) {
+void prepare(const pipeline::Shot& shot, const Request& request) {
+  const Scope scope(shot, request);
   // Everything that can fail on the inputs fails here, before a single task writes a file.
+  (void)load_exemplars_checked(shot, request, "the prepare task", {TaskKind::kPrepare});
   (void)open_frames(shot);
-  (void)load_exemplars(shot);
   (void)load_composite_inputs(shot);
   (void)load_weight_maps(shot);
   io::FileStore store(shot);
@@ -82,7 +123,8 @@ void prepare(const pipeline::Shot& shot) {
 int render_passes(const pipeline::Shot& shot, const Request& request) {
   pipeline::check_run_options(shot, run_options(request));
   if (shot.source.kind != pipeline::SourceKind::kScene) return 0;
-  use_threads(shot, request);
+  const Scope scope(shot, request);
+  check_peak_memory(shot, request, "the passes task", {TaskKind::kPasses});
   const auto frames = open_frames(shot);
   io::FileStore store(shot, io::StoreMode::kRun, access(request));
   const int a = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
@@ -97,6 +139,8 @@ int render_passes(const pipeline::Shot& shot, const Request& request) {
 }
 
 std::vector<std::string> write_previews(const pipeline::Shot& shot, const Request& request) {
+  const Scope scope(shot, request);
+  check_peak_memory(shot, request, "the previews task", {TaskKind::kPreviews});
   io::FileStore store(shot, io::StoreMode::kReadFinished, access(request));
   std::vector<std::string> written =
       io::write_previews(shot, shot.source.first_frame, shot.source.last_frame);
@@ -129,7 +173,7 @@ const pipeline::Layer& measured_range(const pipeline::Shot& shot, const std::str
 
 FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,
                       const Request& request) {
-  use_threads(shot, request);
+  const Scope scope(shot, request);
   FlickerResult out;
   const pipeline::Layer* l = &measured_range(shot, layer, request, out.first_frame, out.last_frame);
   const auto frames = open_frames(shot);
@@ -141,11 +185,12 @@ FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,
 }
 
 GhostResult ghost(const pipeline::Shot& shot, const std::string& layer, const Request& request) {
-  use_threads(shot, request);
+  const Scope scope(shot, request);
   GhostResult out;
   const pipeline::Layer& l = measured_range(shot, layer, request, out.first_frame, out.last_frame);
+  const auto exemplars =
+      load_exemplars_checked(shot, request, "measuring ghosts", {TaskKind::kLayer});
   const auto frames = open_frames(shot);
-  const auto exemplars = load_exemplars(shot);
   const pipeline::WeightMapImages maps = load_weight_maps(shot);
   io::FileStore store(shot, io::StoreMode::kReadFinished);
   const auto reference = [&](int f) {

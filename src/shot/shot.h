@@ -30,6 +30,9 @@ struct Request : pipeline::RunOptions {
   // A render-farm task beside other tasks of the same shot (shot/plan.h): shares the output
   // folder's lock, leaves clean-up to the prepare task and needs the folder prepared.
   bool farm_task = false;
+  // Refuse the work when its estimated peak memory exceeds this many MB (0: no limit but what
+  // the machine has available, which is always checked).
+  int64_t max_memory_mb = 0;
 };
 
 struct RunResult {
@@ -53,7 +56,7 @@ CompositeResult composite(const pipeline::Shot& shot, const Request& request);
 // A farm's first task of a shot: checks every input, locks the folder alone, removes what a
 // killed run left and brings every manifest up to date (deleting outputs made under other
 // settings), so that the shot's other tasks can then run side by side.
-void prepare(const pipeline::Shot& shot);
+void prepare(const pipeline::Shot& shot, const Request& request = {});
 
 // Renders the requested frames' guide passes into the shot's pass cache (passes/), skipping
 // frames already there; every later task reads them instead of rendering. A sequence source

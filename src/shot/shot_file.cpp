@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "io/input_file.h"
 #include "shot/parse.h"
 
 namespace emaki::shot {
@@ -206,8 +207,9 @@ Shot parse_shot(std::string_view text, const std::string& path) {
   // First: the budget applies to source.size and to the sequence's first frame read below.
   if (const toml::table* t = top.table("limits")) {
     const Reader r(*t, "limits", "limits");
-    if (r.has("max_pixels")) set_max_pixels_from_file(r.integer64("max_pixels", 0));
+    if (r.has("max_pixels")) shot.max_pixels = r.integer64("max_pixels", 0);
   }
+  const ScopedMaxPixels budget(shot_max_pixels(shot.max_pixels));
   parse_source(Reader(*top.table("source", true), "source", "source"), ctx, shot.source);
   parse_exemplars(*top.table("exemplars", true), ctx, shot);
   parse_layers(*top.table("layers", true), shot);
@@ -222,6 +224,9 @@ Shot parse_shot(std::string_view text, const std::string& path) {
 }
 
 Shot load_shot(const std::string& path) {
+  // Checked before opening: opening a FIFO waits for a writer.
+  if (const std::string problem = io::input_file_problem(path); !problem.empty())
+    throw Error(path, problem);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot open the shot file");
   // Read at most one byte past the cap: a huge file (or /dev/zero) is refused without reading it.

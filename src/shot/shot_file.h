@@ -20,8 +20,9 @@ inline constexpr int kMaxShotDepth = 64;
 
 // Parses and checks a shot file: syntax, keys, types, ranges, references between sections,
 // input files that must exist, and that the output folder can be written. Throws emaki::Error.
-// A `limits.max_pixels` in the file sets the process's pixel budget unless the command line
-// pinned one (--max-pixels).
+// A `limits.max_pixels` in the file is the shot's pixel budget (pipeline::Shot::max_pixels),
+// applied while the file is parsed and during the shot's work (shot/shot.h), unless the command
+// line pinned one (--max-pixels); it never changes the budget of anything else.
 pipeline::Shot load_shot(const std::string& path);
 
 // The same from text (`path` is used for messages and to resolve relative paths).

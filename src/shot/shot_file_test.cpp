@@ -1,6 +1,8 @@
 #include "shot/shot_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <string>
 #include <vector>
@@ -152,6 +154,39 @@ TEST(ShotFile, ErrorsNameAVeryLongPathByItsEnds) {
                "sequence = \"" + folder + "/frame_%04d.exr\"\nframes = [0, 3]\n");
   expect_errors({{text, "source.sequence: no such file '/nonexistent/ddd",
                   "...(1028 bytes)..." + std::string(265, 'd') + "/frame_0000.exr' (frame 0)"}});
+}
+
+// A device or a FIFO exists: it is "not a regular file", never "no such file"; a FIFO given as
+// the shot file is refused without being opened (opening waits for a writer).
+TEST(ShotFile, DevicesAndFifosAreNotRegularFiles) {
+  std::string text = minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n");
+  const std::string painting = kData + "/stylit/source_style.png";
+  text.replace(text.find(painting), painting.size(), "/dev/zero");
+  EXPECT_EQ(error_of(text),
+            "exemplars.sphere.painting: '/dev/zero' is not a regular file (a device, FIFO or "
+            "socket)");
+  std::string scene = minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n");
+  const std::string fox = kData + "/scenes/Fox.glb";
+  scene.replace(scene.find(fox), fox.size(), "/dev/null");
+  EXPECT_NE(error_of(scene).find("'/dev/null' is not a regular file"), std::string::npos)
+      << error_of(scene);
+
+  const std::string fifo = "/tmp/emaki_shot_file_test_fifo_" + std::to_string(::getpid());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string message;
+  try {
+    load_shot(fifo);
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  ::unlink(fifo.c_str());
+  EXPECT_EQ(message, fifo + ": is not a regular file (a device, FIFO or socket)");
+  try {
+    load_shot("/dev/zero");
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message, "/dev/zero: is not a regular file (a device, FIFO or socket)");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "io/input_file.h"
 #include "render/passes.h"
 
 namespace emaki::shot {
@@ -230,9 +231,8 @@ std::string PathContext::input_file(const Reader& r, std::string_view key, bool 
     return raw;
   }
   const std::string p = resolve(raw);
-  std::error_code ec;
-  if (!fs::is_regular_file(p, ec))
-    throw Error(r.key_path(key), fmt::format("no such file '{}'", echo_path(p)));
+  if (const std::string problem = io::input_file_problem(p, echo_path(p)); !problem.empty())
+    throw Error(r.key_path(key), problem);
   return p;
 }
 

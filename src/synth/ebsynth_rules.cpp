@@ -34,10 +34,6 @@ int effective_channels(const ImageView<const T>& v) {
   return nc;
 }
 
-bool same_size(const Plane& a, const Plane& b) {
-  return plane_width(a) == plane_width(b) && plane_height(a) == plane_height(b);
-}
-
 }  // namespace
 
 int effective_channels(const Plane& p) {
@@ -77,20 +73,40 @@ void RuledInputs::release_guides() {
   made_for_guide_.assign(made_.size(), false);
 }
 
+void check_guide_sizes(const NamedSize& style,
+                       const std::vector<std::pair<NamedSize, NamedSize>>& guides) {
+  for (const auto& [source, target] : guides)
+    if (source.width != style.width || source.height != style.height)
+      throw Error(source.name,
+                  fmt::format("source guide is {}x{} but the style '{}' is {}x{}", source.width,
+                              source.height, style.name, style.width, style.height));
+  // Name the right image when sizes disagree.
+  for (std::size_t k = 1; k < guides.size(); ++k) {
+    const NamedSize &t = guides[k].second, &t0 = guides[0].second;
+    if (t.width != t0.width || t.height != t0.height)
+      throw Error(t.name, fmt::format("target guide is {}x{} but '{}' is {}x{}", t.width, t.height,
+                                      t0.name, t0.width, t0.height));
+  }
+}
+
+namespace {
+NamedSize size_of(const NamedPlane& p) {
+  return {p.name, plane_width(p.plane), plane_height(p.plane)};
+}
+}  // namespace
+
 RuledInputs apply_ebsynth_rules(const NamedPlane& style, const std::vector<NamedGuide>& guides,
                                 const std::optional<NamedPlane>& mask) {
+  std::vector<std::pair<NamedSize, NamedSize>> sizes;
+  for (const NamedGuide& g : guides) sizes.emplace_back(size_of(g.source), size_of(g.target));
+  check_guide_sizes(size_of(style), sizes);
   RuledInputs r;
   Inputs& in = r.inputs;
   const int ns = effective_channels(style.plane);
   if (ns > 4) throw Error(style.name, "style must have 1 to 4 channels");
   in.style = r.with_channels(style.plane, ns, false);
   in.style_name = style.name;
-  const int sw = plane_width(style.plane), sh = plane_height(style.plane);
   for (const NamedGuide& g : guides) {
-    if (plane_width(g.source.plane) != sw || plane_height(g.source.plane) != sh)
-      throw Error(g.source.name, fmt::format("source guide is {}x{} but the style '{}' is {}x{}",
-                                             plane_width(g.source.plane),
-                                             plane_height(g.source.plane), style.name, sw, sh));
     const int na = effective_channels(g.source.plane), nb = effective_channels(g.target.plane);
     const int nc = std::max(na, nb);
     // Named by the file that has too many, so the user knows which one to fix.
@@ -105,15 +121,6 @@ RuledInputs apply_ebsynth_rules(const NamedPlane& style, const std::vector<Named
     gp.weight = g.weight;
     in.guides.push_back(gp);
   }
-  // Name the right image when sizes disagree.
-  for (std::size_t k = 1; k < guides.size(); ++k)
-    if (!same_size(guides[k].target.plane, guides[0].target.plane))
-      throw Error(
-          guides[k].target.name,
-          fmt::format("target guide is {}x{} but '{}' is {}x{}",
-                      plane_width(guides[k].target.plane), plane_height(guides[k].target.plane),
-                      guides[0].target.name, plane_width(guides[0].target.plane),
-                      plane_height(guides[0].target.plane)));
   if (mask) {
     in.target_mask = mask->plane;
     in.target_mask_name = mask->name;

@@ -11,6 +11,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -65,6 +66,18 @@ class RuledInputs {
   std::vector<Made> made_;
   std::vector<bool> made_for_guide_;
 };
+
+// An image's name and size: what the size checks need, before any pixel is read or copied.
+struct NamedSize {
+  std::string name;
+  int width = 0, height = 0;
+};
+
+// Throws emaki::Error naming the image for a source guide whose size is not the style's, or
+// target guides of different sizes. apply_ebsynth_rules checks this first; a caller that must
+// copy its inputs (an array of another layout) calls it before copying.
+void check_guide_sizes(const NamedSize& style,
+                       const std::vector<std::pair<NamedSize, NamedSize>>& guides);
 
 // Applies the rules; throws emaki::Error naming the image (NamedPlane::name) for a style or
 // guide with more than 4 channels that count, a source guide whose size is not the style's, or

@@ -118,10 +118,9 @@ TEST(Synthesize, BitIdenticalForAnyThreadCountAndRun) {
   req.nnf = true;
   std::vector<Result> results;
   for (int threads : {1, 2, 3, 2}) {
-    set_thread_count(threads);
+    const ScopedThreadCount count(threads);
     results.push_back(synthesize(f.inputs(), params, req));
   }
-  set_thread_count(0);
   for (std::size_t i = 1; i < results.size(); ++i) {
     EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
     for (int y = 0; y < 72; ++y)
@@ -170,10 +169,9 @@ TEST(Synthesize, WarmStartFromAGivenField) {
   warm.finest_search_vote_iters = 1;
   std::vector<Result> results;
   for (int threads : {1, 2, 3}) {
-    set_thread_count(threads);
+    const ScopedThreadCount count(threads);
     results.push_back(synthesize(f.inputs(), warm, req));
   }
-  set_thread_count(0);
   for (std::size_t i = 1; i < results.size(); ++i)
     EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
 

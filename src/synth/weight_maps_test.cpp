@@ -151,13 +151,12 @@ TEST(WeightMaps, BitIdenticalForAnyThreadCountAndKernel) {
   in.guides[1].weight_map = Plane(map.cview());
   std::vector<Result> results;
   for (int threads : {1, 2, 3}) {
-    set_thread_count(threads);
+    const ScopedThreadCount count(threads);
     results.push_back(run(in));
   }
   setenv("EMAKI_SIMD", "scalar", 1);
   results.push_back(run(in));
   unsetenv("EMAKI_SIMD");
-  set_thread_count(0);
   for (std::size_t i = 1; i < results.size(); ++i) {
     EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
     EXPECT_TRUE(same_nnf(results[0].nnf, results[i].nnf)) << "run " << i;
