@@ -257,8 +257,9 @@ TEST_F(OutputSafety, RunsWithHugePagesWhereTheKernelTakesAdvice) {
   t.mp4 = true;
   write_shot(t);
   fs::create_directories(dir_ / "bin");
-  write_text(dir_ / "bin/ffmpeg",
-             "#!/bin/sh\nprintf '%s' \"$GLIBC_TUNABLES\" > '" + p("tunables") + "'\n");
+  // It writes its output (the last argument): an empty MP4 is refused as a failed write.
+  write_text(dir_ / "bin/ffmpeg", "#!/bin/sh\nprintf '%s' \"$GLIBC_TUNABLES\" > '" + p("tunables") +
+                                      "'\nfor out; do :; done\nprintf stand-in > \"$out\"\n");
   fs::permissions(dir_ / "bin/ffmpeg", fs::perms::owner_all);
   test::CliOptions o;
   o.cwd = dir_;
