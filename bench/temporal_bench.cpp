@@ -53,6 +53,7 @@
 #include "render/passes.h"
 #include "shot/inputs.h"
 #include "shot/shot.h"
+#include "texture_measures.h"
 
 namespace {
 
@@ -68,6 +69,7 @@ struct Options {
   std::vector<std::string> variants = {"frame", "rest_position_noconf_uniform@1",
                                        "rest_position_uniform", "position", "rest_position"};
   temporal::ConfidenceParams confidence;
+  bool confidence_set = false;        // any of --error-*, --foreign-none, --erode given
   float temporal_weight = -1.0f;      // -1: the example's
   float temporal_uniformity = -1.0f;  // for `_uniform` variants; -1: the layer's uniformity
 };
@@ -86,7 +88,7 @@ struct Options {
 
 // A variant's base name: without @WEIGHT and _uniform.
 std::string base_name(const std::string& variant) {
-  std::string name = variant.substr(0, variant.find('@'));
+  std::string name = variant.substr(0, std::min(variant.find('@'), variant.find(':')));
   // The modifiers, in any order.
   for (bool stripped = true; stripped;) {
     stripped = false;
@@ -128,12 +130,16 @@ Options parse(int argc, char** argv) {
       o.variants = parse_variants(v);
     } else if (a == "--error-full") {
       o.confidence.error_full = std::strtof(v.c_str(), nullptr);
+      o.confidence_set = true;
     } else if (a == "--error-none") {
       o.confidence.error_none = std::strtof(v.c_str(), nullptr);
+      o.confidence_set = true;
     } else if (a == "--foreign-none") {
       o.confidence.foreign_none = std::strtof(v.c_str(), nullptr);
+      o.confidence_set = true;
     } else if (a == "--erode") {
       o.confidence.erode = std::atoi(v.c_str());
+      o.confidence_set = true;
     } else if (a == "--temporal-weight") {
       o.temporal_weight = std::strtof(v.c_str(), nullptr);
     } else if (a == "--temporal-uniformity") {
@@ -218,6 +224,8 @@ struct Variant {
   double style_sum = 0.0, coverage_sum = 0.0;
   double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
   int drift_frames = 0;
+  bench::ToneTexture tone;  // inside the mask, over the last quarter
+  bench::ToneTexture wash;  // in recently disoccluded pixels inside the mask, every frame
 };
 
 double mean_value(const Image<float>& v) {
@@ -249,6 +257,34 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
   }
 }
 
+// The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma), u=U (temporal
+// uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed).
+void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
+  std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
+  for (std::string m; std::getline(ss, m, ':');) {
+    if (m.empty()) continue;
+    const std::size_t eq = m.find('=');
+    if (eq == std::string::npos) usage("bad modifier " + m);
+    const std::string key = m.substr(0, eq), value = m.substr(eq + 1);
+    const float x = std::strtof(value.c_str(), nullptr);
+    if (key == "s") {
+      l.temporal.guide_sigma = x;
+    } else if (key == "u") {
+      l.temporal.uniformity = x;
+    } else if (key == "w") {
+      l.temporal.weight = x;
+    } else if (key == "c") {
+      l.temporal.confidence_params.change_full = x;
+      l.temporal.confidence_params.change_none =
+          std::strtof(value.c_str() + value.find('/') + 1, nullptr);
+    } else if (key == "r") {
+      l.temporal.reseed = x != 0.0f;
+    } else {
+      usage("bad modifier " + m);
+    }
+  }
+}
+
 pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, const Options& o) {
   const std::size_t at = variant.find('@');
   const std::string name = base_name(variant);
@@ -257,12 +293,14 @@ pipeline::Layer variant_layer(pipeline::Layer l, const std::string& variant, con
                                                     : pipeline::AdvectionGuide::kRestPosition;
   l.temporal.confidence = name.find("_noconf") == std::string::npos;
   if (variant.find("_cold") != std::string::npos) l.temporal.warm_start = false;
-  l.temporal.confidence_params = o.confidence;
+  if (o.confidence_set) l.temporal.confidence_params = o.confidence;
   if (o.temporal_weight >= 0.0f) l.temporal.weight = o.temporal_weight;
-  if (at != std::string::npos) l.temporal.weight = std::strtof(variant.c_str() + at + 1, nullptr);
+  if (at != std::string::npos && at < variant.find(':'))
+    l.temporal.weight = std::strtof(variant.c_str() + at + 1, nullptr);
   if (variant.find("_uniform") != std::string::npos)
     l.temporal.uniformity =
         o.temporal_uniformity >= 0.0f ? o.temporal_uniformity : l.synth.uniformity;
+  apply_modifiers(l, variant);
   return l;
 }
 
@@ -341,7 +379,7 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
 // when it is the first one) and, with --save, the frame as a PNG.
 void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& layer,
                    const Image<float>& passes, const Image<float>& prev_passes, int f,
-                   bool drift_frame, const Options& opt) {
+                   bool drift_frame, const Image<uint8_t>& disoccluded, const Options& opt) {
   const int n = layer.single_colour ? 1 : 3;
   const Image<float> cur = v.store.read_layer(layer, f), prev = v.store.read_layer(layer, f - 1);
   const int mask_channel = cur.channels() > n ? n : -1;
@@ -352,9 +390,12 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
     v.ghost.add(pipeline::frame_ghost(v.layer, cur.cview(), prev.cview(), ref.cview(),
                                       passes.cview(), prev_passes.cview(), f)
                     .stats);
+    const Image<float> cur_white = on_white(cur, n), ref_white = on_white(ref, n);
+    bench::add_tone_texture(v.wash, cur_white, ref_white, cur, mask_channel, disoccluded);
     if (drift_frame) {
-      v.drift_sum += mean_value(on_white(cur, n)) - mean_value(on_white(ref, n));
+      v.drift_sum += mean_value(cur_white) - mean_value(ref_white);
       ++v.drift_frames;
+      bench::add_tone_texture(v.tone, cur_white, ref_white, cur, mask_channel, {});
     }
   }
   if (!opt.save.empty())
@@ -396,6 +437,19 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
   }
 }
 
+// Against frame by frame, same pixels: tone drift and texture kept inside the mask over the last
+// quarter, and both again over the pixels disoccluded within the last few frames (the wash).
+void print_tone_table(const std::vector<Variant>& variants) {
+  std::printf("\n%-24s %9s %9s %11s %11s %12s\n", "variant", "tone", "texture", "wash tone",
+              "wash tex", "wash pixels");
+  for (const Variant& v : variants) {
+    if (!v.tone.pixels) continue;
+    std::printf("%-24s %+9.2f %8.3fx %+11.2f %10.3fx %12ld\n", v.name.c_str(),
+                v.tone.drift_levels(), v.tone.texture_kept(), v.wash.drift_levels(),
+                v.wash.texture_kept(), v.wash.pixels);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -416,12 +470,16 @@ int main(int argc, char** argv) {
     if (!opt.save.empty()) std::filesystem::create_directories(opt.save);
     int judged = 0;
     Image<float> prev_passes = source->passes(first);
+    Image<uint8_t> age;  // frames since each pixel's surface was last hidden
     for (int f = first + 1; f <= last; ++f) {
       Image<float> passes = source->passes(f);
+      bench::update_disocclusion_age(age, passes.cview(), prev_passes.cview());
+      const Image<uint8_t> disoccluded = bench::recently_disoccluded(age, passes.cview());
       // Drift: the last quarter of the frames (at least one), where a chain has had time to.
       const bool drift_frame = 4 * (last - f) < last - first + 1;
       for (Variant& v : variants)
-        measure_frame(v, variants[0], *layer, passes, prev_passes, f, drift_frame, opt);
+        measure_frame(v, variants[0], *layer, passes, prev_passes, f, drift_frame, disoccluded,
+                      opt);
       if (judging && (f - first) % opt.judge_every == opt.judge_every / 2) {
         judge_frame(judge_fixed, *layer, passes, f, variants, opt);
         ++judged;
@@ -429,6 +487,7 @@ int main(int argc, char** argv) {
       prev_passes = std::move(passes);
     }
     print_table(variants, opt, first, last, judged);
+    print_tone_table(variants);
     print_objects(shot, variants);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "temporal_bench: %s\n", e.what());

@@ -14,6 +14,7 @@
 #include "render/passes.h"
 #include "synth/synthesizer.h"
 #include "temporal/advection.h"
+#include "temporal/guide_change.h"
 
 namespace emaki::pipeline {
 
@@ -28,6 +29,7 @@ struct PreparedLayer {
   Image<float> style;                             // A': the touch (1 channel) or the painting's RGB
   std::vector<Image<float>> source_guides;        // one per layer->guides entry
   std::vector<const Image<float>*> painted_maps;  // per guide: its painted weight map, or null
+  Image<float> temporal_style;  // A' low-passed for the temporal guide (guide_sigma), or empty
 };
 
 PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const WeightMapImages& maps) {
@@ -48,6 +50,8 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     CHECK(g.map_image.empty() || it != maps.end());  // shot::load_weight_maps read every one
     p.painted_maps.push_back(it == maps.end() ? nullptr : &it->second);
   }
+  if (layer.temporal.enabled && layer.temporal.guide_sigma > 0.0f)
+    p.temporal_style = temporal::low_pass(p.style.cview(), layer.temporal.guide_sigma);
   return p;
 }
 
@@ -69,6 +73,43 @@ void warm_schedule(const SynthSpec& s, synth::Params& p) {
   p.search_vote_iters = 1;
   p.patch_match_iters = 2;
   p.search_radius = 32;
+}
+
+// The temporal guide pair of a layer at a temporal frame: B'adv and its confidence, both sides
+// low-passed with guide_sigma. `target` holds what the pair's target view points into.
+struct TemporalPair {
+  temporal::Advection advected;
+  Image<float> target;
+};
+
+void add_temporal_guide(const PreparedLayer& p, ImageView<const float> passes,
+                        const Image<float>& mask, int frame, const Image<float>& previous,
+                        const Image<float>& previous_passes, AdvectionFields* fields,
+                        TemporalPair& t, synth::Inputs& inputs) {
+  const Layer& l = *p.layer;
+  t.advected =
+      advect_layer(l, passes, mask, previous.cview(), previous_passes.cview(), frame, fields);
+  const bool low = l.temporal.guide_sigma > 0.0f;
+  if (low)
+    t.target = temporal::low_pass(t.advected.value.cview(), l.temporal.guide_sigma,
+                                  mask.empty() ? ImageView<const float>{} : mask.cview());
+  synth::GuidePair pair{fmt::format("layers.{}.temporal", l.name),
+                        low ? p.temporal_style.cview() : p.style.cview(),
+                        low ? t.target.cview() : t.advected.value.cview(), l.temporal.weight};
+  if (!t.advected.confidence.empty()) pair.weight_map = synth::Plane(t.advected.confidence.cview());
+  inputs.guides.push_back(pair);
+}
+
+// The warm start's field: the previous field carried along the frame's advection field, with
+// the entries dropped (drawn afresh) where the temporal guide has no confidence (reseed).
+Image<int32_t> warm_field(const Layer& l, ImageView<const int32_t> previous_nnf,
+                          const temporal::AdvectionField& field, const Image<float>& confidence) {
+  Image<int32_t> warm = carry_field(previous_nnf, field);
+  if (!l.temporal.reseed || warm.empty() || confidence.empty()) return warm;
+  for (int y = 0; y < warm.height(); ++y)
+    for (int x = 0; x < warm.width(); ++x)
+      if (confidence(x, y) <= 0.0f) warm(x, y, 0) = warm(x, y, 1) = -1;
+  return warm;
 }
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
@@ -107,15 +148,11 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     }
     inputs.guides.push_back(pair);
   }
-  temporal::Advection advected;
-  if (previous && previous_passes) {
-    advected =
-        advect_layer(l, passes, mask, previous->cview(), previous_passes->cview(), frame, fields);
-    synth::GuidePair pair{fmt::format("layers.{}.temporal", l.name), p.style.cview(),
-                          advected.value.cview(), l.temporal.weight};
-    if (!advected.confidence.empty()) pair.weight_map = synth::Plane(advected.confidence.cview());
-    inputs.guides.push_back(pair);
-  }
+  TemporalPair temporal_pair;
+  const temporal::Advection& advected = temporal_pair.advected;
+  if (previous && previous_passes)
+    add_temporal_guide(p, passes, mask, frame, *previous, *previous_passes, fields, temporal_pair,
+                       inputs);
   if (!mask.empty()) inputs.target_mask = mask.cview();
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
   // With a temporal guide, B'adv already carries the previous frame's converged texture: one
@@ -128,7 +165,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     params.uniformity = l.temporal.uniformity;
     const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
-      warm = carry_field(previous_nnf, *field);
+      warm = warm_field(l, previous_nnf, *field, advected.confidence);
       params.initial_nnf = warm.cview();
       warm_schedule(l.synth, params);
     }

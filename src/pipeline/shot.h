@@ -130,6 +130,13 @@ struct TemporalSpec {
   // inside a finished shot then continues exactly), or the last finished frame's alone (a
   // resumed run still does; a forced range starts its first frame from the whole pyramid).
   bool keep_every_field = true;
+  // Both sides of the temporal guide — the exemplar A' and B'adv — low-passed by a Gaussian of
+  // this sigma in pixels (0: none): voting and resampling soften B'adv, and matching it against
+  // a sharp A' favours the exemplar's flattest patches, so the chain fades frame by frame.
+  float guide_sigma = 0.0f;
+  // A warm start drops the carried field where the temporal guide has no confidence (surface
+  // hidden at t-1, the layer's guides changed): those pixels are searched afresh.
+  bool reseed = false;
 };
 
 struct SynthSpec {

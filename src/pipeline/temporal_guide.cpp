@@ -1,5 +1,7 @@
 #include "pipeline/temporal_guide.h"
 
+#include <algorithm>
+
 #include "core/rng.h"
 #include "pipeline/frames.h"
 #include "render/passes.h"
@@ -51,6 +53,32 @@ Image<int32_t> carry_field(ImageView<const int32_t> previous, const temporal::Ad
   return out;
 }
 
+namespace {
+
+// The layer's guides whose change along the advection means the painting's answer changed: all
+// but the normals, which turn with every rotation of the camera or the surface.
+Image<float> change_guides(const Layer& l, ImageView<const float> passes) {
+  std::vector<Image<float>> parts;
+  int channels = 0;
+  for (const GuideSpec& g : l.guides)
+    if (g.pass != "normal") {
+      parts.push_back(extract_pass(passes, g.pass));
+      channels += parts.back().channels();
+    }
+  if (parts.empty()) return {};
+  Image<float> out(passes.width, passes.height, channels);
+  int c0 = 0;
+  for (const Image<float>& p : parts) {
+    for (int y = 0; y < passes.height; ++y)
+      for (int x = 0; x < passes.width; ++x)
+        for (int c = 0; c < p.channels(); ++c) out(x, y, c0 + c) = std::clamp(p(x, y, c), 0.f, 1.f);
+    c0 += p.channels();
+  }
+  return out;
+}
+
+}  // namespace
+
 temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
                                  ImageView<const float> previous_passes, int frame,
@@ -65,7 +93,7 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
   a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
   if (!mask.empty()) a.current_mask = mask.cview();
   // The confidence's evidence: the surfaces (rest position + object id) whatever the guide.
-  Image<float> surf_prev, surf_cur, motion;
+  Image<float> surf_prev, surf_cur, motion, change_prev, change_cur;
   if (l.temporal.confidence) {
     const bool rest = l.temporal.guide == AdvectionGuide::kRestPosition;
     if (!rest) {
@@ -76,6 +104,12 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
     a.surfaces = temporal::Surfaces{rest ? guide_prev.cview() : surf_prev.cview(),
                                     rest ? guide_cur.cview() : surf_cur.cview(), motion.cview()};
     a.confidence = l.temporal.confidence_params;
+    if (a.confidence.change_none > 0.0f) {
+      change_prev = change_guides(l, previous_passes);
+      change_cur = change_guides(l, passes);
+      if (!change_cur.empty())
+        a.previous_layer_guides = change_prev.cview(), a.current_layer_guides = change_cur.cview();
+    }
   }
   const synth::Params params = synth_params(l.synth, frame_seed(l, frame, 1));
   if (!fields) return temporal::advect(a, params);

@@ -319,7 +319,8 @@ ShotRenderer::ShotRenderer(const scene::Scene& scene, const scene::ShotSpec& sho
   ground_height_ = shot_.ground.auto_height && !shot_bounds_.empty()
                        ? shot_bounds_.lo.y - 1e-4f * glm::length(shot_bounds_.size())
                        : shot_.ground.height;
-  light_ = scene::light_direction(shot_, camera(float(shot_.first_frame)));
+  first_camera_ = camera(float(shot_.first_frame));
+  light_ = scene::light_direction(shot_, first_camera_, float(shot_.first_frame));
 }
 
 float ShotRenderer::time_of(float frame) const {
@@ -359,13 +360,14 @@ Image<float> ShotRenderer::render(int frame) const {
     ro.znear = proj.cam.znear;
     rasterize(verts, g.indices, ro, vb);
   }
-  const ShadowMap shadow(g, light_, shot_.light.softness_deg, options_.shadow_map_size);
+  const glm::vec3 light = scene::light_direction(shot_, first_camera_, float(frame));
+  const ShadowMap shadow(g, light, shot_.light.softness_deg, options_.shadow_map_size);
 
   Image<float> out(W, H, kChannelCount);
   const glm::mat3 view_rot(proj.cam.view);
   const glm::vec3 eye = proj.cam.position();
   const glm::vec3 forward = glm::transpose(view_rot) * glm::vec3(0, 0, -1);
-  const Shading shading{scene_, g, proj, prev_proj, shadow, view_rot, eye, forward, light_};
+  const Shading shading{scene_, g, proj, prev_proj, shadow, view_rot, eye, forward, light};
   parallel_rows(H, 4, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < W; ++x) {

@@ -47,6 +47,8 @@ class ShotRenderer {
   int animation() const { return animation_; }
   const scene::Bounds& position_box() const { return position_box_; }
   const scene::Bounds& rest_box() const { return rest_box_; }
+  // The light at the first frame (LightSpec::turn_deg turns it over the range; render() uses
+  // each frame's).
   const glm::vec3& light() const { return light_; }
   // The camera at a frame (fractional frames allowed; motion uses frame - 1).
   scene::ViewCamera camera(float frame) const;
@@ -61,6 +63,7 @@ class ShotRenderer {
   scene::Bounds rest_box_;             // cube around the rest-pose bounds
   std::vector<glm::vec3> fit_points_;  // vertices over the shot, framed by the automatic camera
   float ground_height_ = 0.0f;
+  scene::ViewCamera first_camera_;  // resolves a camera-relative light direction
   glm::vec3 light_{0, 1, 0};
 };
 

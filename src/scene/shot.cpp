@@ -128,13 +128,17 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
   return cam;
 }
 
-glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera) {
+glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera, float frame) {
   glm::vec3 d = shot.light.direction;
   if (glm::length(d) < 1e-12f) d = glm::vec3(0, 1, 0);
   d = glm::normalize(d);
   if (shot.light.camera_relative)
     d = glm::normalize(glm::transpose(glm::mat3(first_camera.view)) * d);
-  return d;
+  if (shot.light.turn_deg == 0.0f || shot.last_frame <= shot.first_frame) return d;
+  const float u = (frame - float(shot.first_frame)) / float(shot.last_frame - shot.first_frame);
+  const float a = shot.light.turn_deg * kDeg * u;
+  return glm::normalize(glm::vec3(std::cos(a) * d.x + std::sin(a) * d.z, d.y,
+                                  -std::sin(a) * d.x + std::cos(a) * d.z));
 }
 
 }  // namespace emaki::scene

@@ -44,6 +44,10 @@ struct LightSpec {
   glm::vec3 direction{-1.0f, 1.0f, 1.0f};
   bool camera_relative = true;
   float softness_deg = 2.0f;  // angular size of the light: widens the shadow penumbra, [0, 45]
+  // Degrees the light turns about world +Y from the first to the last frame of the range
+  // (linear, extrapolated outside it, as the camera's orbit): a sun that moves, shadows that
+  // sweep across the ground.
+  float turn_deg = 0.0f;
 };
 
 struct GroundSpec {
@@ -88,7 +92,8 @@ ViewCamera camera_at(const ShotSpec& shot, const Scene& scene, const Pose& pose,
                      const Bounds& bounds, float frame, float aspect,
                      const std::vector<glm::vec3>* fit_points = nullptr);
 
-// The key light direction (unit, towards the light) in world space for the whole shot.
-glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera);
+// The key light direction (unit, towards the light) in world space at `frame` (fractional frames
+// allowed): `direction` resolved with the first frame's camera, turned by LightSpec::turn_deg.
+glm::vec3 light_direction(const ShotSpec& shot, const ViewCamera& first_camera, float frame);
 
 }  // namespace emaki::scene

@@ -15,13 +15,19 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       d.mask = {pipeline::MaskKind::kShadow, 2.0f, 0.5f};
       d.look.flat = {0.55f, 0.52f, 0.7f};
       d.look.blend = composite::BlendMode::kMultiply;
+      // The warm start alone carries the shadow: a temporal guide and the uniformity term both
+      // lightened it frame by frame (docs/design/temporal-default.md).
+      d.temporal_weight = 0.0f;
+      d.temporal_uniformity = 0.0f;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};
       d.mask = {pipeline::MaskKind::kLines, 3.0f, 0.1f};
       d.look.flat = {0.08f, 0.06f, 0.06f};
       d.look.alpha_from = composite::AlphaFrom::kInverseValue;
-      d.temporal_weight = 0.5f;
+      // As the shadow: the temporal guide faded the ink (docs/design/temporal-default.md).
+      d.temporal_weight = 0.0f;
+      d.temporal_uniformity = 0.0f;
       break;
     case pipeline::LayerKind::kCustom:
       break;

@@ -99,6 +99,7 @@ struct KindDefaults {
   pipeline::MaskSpec mask;
   composite::LayerLook look;
   float temporal_weight = 1.0f;
+  float temporal_uniformity = 1000.0f;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

@@ -97,6 +97,7 @@ void parse_light_and_ground(const Reader& r, scene::ShotSpec& shot) {
       throw Error(l.key_path("direction"), "must not be [0, 0, 0]");
     shot.light.camera_relative = !l.boolean("world", false);
     shot.light.softness_deg = l.real("softness", shot.light.softness_deg);
+    shot.light.turn_deg = l.real("turn", shot.light.turn_deg);
   }
   if (const toml::table* t = r.table("ground")) {
     Reader g(*t, r.key_path("ground"), "source.ground");

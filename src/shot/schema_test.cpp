@@ -54,7 +54,7 @@ TEST(Schema, KeysAreUniqueAndUnderTheirTables) {
   EXPECT_EQ(child_keys(""), (std::vector<std::string>{"threads", "limits", "source", "exemplars",
                                                       "layers", "compositing", "outputs"}));
   EXPECT_EQ(child_keys("source.light"),
-            (std::vector<std::string>{"direction", "world", "softness"}));
+            (std::vector<std::string>{"direction", "world", "softness", "turn"}));
   EXPECT_NE(find_key("layers.NAME.guides.PASS"), nullptr);
   EXPECT_EQ(find_key("layers.NAME.wieght"), nullptr);
 }

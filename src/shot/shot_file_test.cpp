@@ -38,6 +38,19 @@ TEST(ShotFile, EditDistance) {
   EXPECT_EQ(closest_key("banana", {"weight", "width"}), "");
 }
 
+TEST(ShotFile, LightTurnIsReadAndRanged) {
+  const std::string layer = "[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n";
+  auto with_light = [&](const std::string& light) {
+    std::string text = minimal(layer);
+    text.insert(text.find("[exemplars."), "[source.light]\n" + light + "\n");
+    return text;
+  };
+  EXPECT_FLOAT_EQ(parse_shot(with_light("turn = 60"), "/tmp/shot.toml").source.shot.light.turn_deg,
+                  60.0f);
+  EXPECT_FLOAT_EQ(parse_shot(minimal(layer), "/tmp/shot.toml").source.shot.light.turn_deg, 0.0f);
+  EXPECT_NE(error_of(with_light("turn = 1e9")).find("source.light.turn"), std::string::npos);
+}
+
 TEST(ShotFile, KindsSetTheirDefaults) {
   const pipeline::Shot s =
       parse_shot(minimal("[layers.base]\nkind = \"base\"\nexemplar = \"sphere\"\n"
@@ -53,7 +66,13 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_EQ(s.layers[0].mask.kind, pipeline::MaskKind::kCovered);
   EXPECT_EQ(s.layers[1].mask.kind, pipeline::MaskKind::kLines);
   EXPECT_EQ(s.layers[1].look.alpha_from, composite::AlphaFrom::kInverseValue);
-  EXPECT_FLOAT_EQ(s.layers[1].temporal.weight, 0.5f);
+  EXPECT_FLOAT_EQ(s.layers[0].temporal.weight, 1.0f);
+  EXPECT_FLOAT_EQ(s.layers[0].temporal.uniformity, 1000.0f);
+  // Shadow and outline: the warm start alone (docs/design/temporal-default.md).
+  EXPECT_FLOAT_EQ(s.layers[1].temporal.weight, 0.0f);
+  EXPECT_FLOAT_EQ(s.layers[1].temporal.uniformity, 0.0f);
+  EXPECT_FLOAT_EQ(s.layers[2].temporal.weight, 0.0f);
+  EXPECT_FLOAT_EQ(s.layers[2].temporal.uniformity, 0.0f);
   EXPECT_EQ(s.layers[2].look.blend, composite::BlendMode::kMultiply);
   EXPECT_EQ(s.layers[2].guides[1].pass, "shadow");
   EXPECT_TRUE(s.layers[0].single_colour);

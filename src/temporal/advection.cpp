@@ -5,6 +5,7 @@
 
 #include "core/check.h"
 #include "synth/voting.h"
+#include "temporal/guide_change.h"
 
 namespace emaki::temporal {
 
@@ -100,7 +101,10 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params,
         if (!active(x, y)) nnf(x, y, 0) = nnf(x, y, 1) = -1, error(x, y) = 0.0f;
     out.visible = field->visible.empty() ? visible_before(*in.surfaces) : field->visible.clone();
     out.foreign = foreign_share(nnf, *in.surfaces, patch, patch / 2);
-    out.confidence = confidence(out.visible, out.foreign, error, patch, in.confidence);
+    Image<float> change;
+    if (in.previous_layer_guides && in.current_layer_guides && in.confidence.change_none > 0.0f)
+      change = guide_change(field->nnf, *in.previous_layer_guides, *in.current_layer_guides);
+    out.confidence = confidence(out.visible, out.foreign, error, patch, in.confidence, change);
   }
   if (!in.current_mask) {
     out.value = std::move(voted);

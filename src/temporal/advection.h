@@ -32,6 +32,10 @@ struct AdvectionInputs {
   // With the surfaces of both frames, the advection also says where B'adv can be trusted.
   std::optional<Surfaces> surfaces;
   ConfidenceParams confidence;
+  // With surfaces, optionally: the layer's own guides (stacked channels in [0, 1]) of frames
+  // t-1 and t; the confidence then also drops where they changed along the field
+  // (ConfidenceParams::change_*): a lighting change is re-synthesized, not carried.
+  std::optional<ImageView<const float>> previous_layer_guides, current_layer_guides;
 };
 
 struct Advection {

@@ -149,8 +149,11 @@ Image<float> foreign_share(const Image<int32_t>& nnf, const Surfaces& s, int pat
 }
 
 Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& foreign,
-                        const Image<float>& error, int patch_size, const ConfidenceParams& cp) {
+                        const Image<float>& error, int patch_size, const ConfidenceParams& cp,
+                        const Image<float>& change) {
   const int w = visible.width(), h = visible.height();
+  const bool changes = !change.empty() && cp.change_none > 0.0f;
+  CHECK(!changes || cp.change_full < cp.change_none);
   CHECK_EQ(foreign.width(), w);
   CHECK_EQ(error.width(), w);
   CHECK_LT(cp.error_full, cp.error_none);
@@ -163,7 +166,12 @@ Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& forei
         const float ramp =
             std::clamp((cp.error_none - rms) / (cp.error_none - cp.error_full), 0.0f, 1.0f);
         const float own = std::clamp(1.0f - foreign(x, y) / cp.foreign_none, 0.0f, 1.0f);
-        c(x, y) = visible(x, y) ? own * ramp : 0.0f;
+        const float same =
+            changes
+                ? std::clamp((cp.change_none - change(x, y)) / (cp.change_none - cp.change_full),
+                             0.0f, 1.0f)
+                : 1.0f;
+        c(x, y) = visible(x, y) ? own * ramp * same : 0.0f;
       }
   });
   if (cp.erode <= 0) return c;

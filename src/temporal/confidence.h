@@ -48,15 +48,22 @@ struct ConfidenceParams {
   float error_none = 0.08f;
   // The foreign share: no confidence from foreign_none on, linear below it (1: 1 - foreign).
   float foreign_none = 1.0f;
+  // The change of the layer's own guides along the advection (temporal/guide_change.h): full
+  // confidence up to change_full, none from change_none, linear between; change_none <= 0: not
+  // counted.
+  float change_full = 0.0f;
+  float change_none = 0.0f;
   // Shrink the confident region by this many pixels, so that patches centred next to an
   // untrusted pixel do not carry it either (the weight map applies at patch centres); 0: none.
   int erode = 1;
 };
 
-// visible x the foreign ramp x the error ramp, eroded. `error`: the advection's per-pixel patch
-// error in EbSynth units (synth::Result::error) over guides whose weights sum to 1, which makes
-// sqrt(error / (65025 x patch_size^2)) the RMS guide difference; `patch_size` the advection's.
+// visible x the foreign ramp x the error ramp (x the change ramp, with `change`), eroded. `error`:
+// the advection's per-pixel patch error in EbSynth units (synth::Result::error) over guides whose
+// weights sum to 1, which makes sqrt(error / (65025 x patch_size^2)) the RMS guide difference;
+// `patch_size` the advection's.
 Image<float> confidence(const Image<uint8_t>& visible, const Image<float>& foreign,
-                        const Image<float>& error, int patch_size, const ConfidenceParams& params);
+                        const Image<float>& error, int patch_size, const ConfidenceParams& params,
+                        const Image<float>& change = {});
 
 }  // namespace emaki::temporal

@@ -1,0 +1,108 @@
+// What flicker, ghosts and the judge miss in a temporal chain, measured against frame by frame
+// of the same shot on the same pixels (temporal_bench):
+// - tone drift: the mean level of the layer inside its mask, temporal minus frame by frame, in
+//   levels of 255 (a chain whose ink fades or whose strokes thin out turns positive);
+// - texture kept: the high-pass energy (each value minus the mean of the 5 x 5 box around it,
+//   squared) of the temporal result over frame by frame's, same pixels (a chain that settles
+//   into flat regions falls below 1);
+// - wash: the same two figures over the pixels whose surface was hidden at some frame of the
+//   last `kWashFrames` (disoccluded, tracked along the motion vectors): behind a moving object
+//   the temporal result should look like frame by frame, not a pale, untextured wash.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/image.h"
+#include "pipeline/frames.h"
+#include "render/passes.h"
+#include "temporal/confidence.h"
+
+namespace emaki::bench {
+
+// Frames a disoccluded pixel counts in the wash measure.
+inline constexpr int kWashFrames = 4;
+
+struct ToneTexture {
+  double level_sum = 0.0, reference_level_sum = 0.0;  // values in [0, 1]
+  double energy = 0.0, reference_energy = 0.0;
+  long pixels = 0;
+  double drift_levels() const {
+    return pixels ? 255.0 * (level_sum - reference_level_sum) / double(pixels) : 0.0;
+  }
+  double texture_kept() const { return reference_energy > 0 ? energy / reference_energy : 0.0; }
+};
+
+// v minus the mean of the (2r+1)^2 box around it (clamped at the borders), channel 0.
+inline Image<float> high_pass(const Image<float>& v, int r = 2) {
+  const int w = v.width(), h = v.height();
+  Image<double> integral(w + 1, h + 1, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      integral(x + 1, y + 1) =
+          v(x, y, 0) + integral(x, y + 1) + integral(x + 1, y) - integral(x, y);
+  Image<float> out(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int x0 = std::max(0, x - r), x1 = std::min(w, x + r + 1);
+      const int y0 = std::max(0, y - r), y1 = std::min(h, y + r + 1);
+      const double s = integral(x1, y1) - integral(x0, y1) - integral(x1, y0) + integral(x0, y0);
+      out(x, y) = float(v(x, y, 0) - s / double((x1 - x0) * (y1 - y0)));
+    }
+  return out;
+}
+
+// Adds frame f's figures over the pixels inside `mask_channel` of `value` (every pixel for -1)
+// where `select` (may be empty) is non-zero. `value`, `reference`: the layer's frames over white
+// outside the mask (channel 0 is used), `raw`: the temporal frame with its coverage.
+inline void add_tone_texture(ToneTexture& t, const Image<float>& value,
+                             const Image<float>& reference, const Image<float>& raw,
+                             int mask_channel, const Image<uint8_t>& select) {
+  const Image<float> hv = high_pass(value), hr = high_pass(reference);
+  for (int y = 0; y < value.height(); ++y)
+    for (int x = 0; x < value.width(); ++x) {
+      if (mask_channel >= 0 && raw(x, y, mask_channel) < 0.5f) continue;
+      if (!select.empty() && !select(x, y)) continue;
+      t.level_sum += value(x, y, 0), t.reference_level_sum += reference(x, y, 0);
+      t.energy += double(hv(x, y)) * hv(x, y), t.reference_energy += double(hr(x, y)) * hr(x, y);
+      ++t.pixels;
+    }
+}
+
+// Frames since each pixel's surface was last hidden (0: hidden at t-1), carried along the motion
+// vectors from the previous frame's ages. Start with an empty `age` (everything old).
+inline void update_disocclusion_age(Image<uint8_t>& age, ImageView<const float> passes,
+                                    ImageView<const float> prev_passes) {
+  const Image<float> cur =
+      pipeline::advection_guide(passes, pipeline::AdvectionGuide::kRestPosition);
+  const Image<float> prev =
+      pipeline::advection_guide(prev_passes, pipeline::AdvectionGuide::kRestPosition);
+  const Image<float> motion = pipeline::extract(passes, render::kMotion, 2);
+  const Image<uint8_t> visible =
+      temporal::visible_before({prev.cview(), cur.cview(), motion.cview()});
+  const int w = passes.width, h = passes.height;
+  Image<uint8_t> next(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int sx = int(std::lround(x + motion(x, y, 0))),
+                sy = int(std::lround(y + motion(x, y, 1)));
+      const bool inside = sx >= 0 && sy >= 0 && sx < w && sy < h;
+      const int before = age.empty() || !inside ? 255 : age(sx, sy);
+      next(x, y) = visible(x, y) ? uint8_t(std::min(255, before + 1)) : 0;
+    }
+  age = std::move(next);
+}
+
+// The pixels disoccluded within the last kWashFrames frames, covered by an object.
+inline Image<uint8_t> recently_disoccluded(const Image<uint8_t>& age,
+                                           ImageView<const float> passes) {
+  Image<uint8_t> out(age.width(), age.height(), 1);
+  for (int y = 0; y < age.height(); ++y)
+    for (int x = 0; x < age.width(); ++x)
+      out(x, y) = age(x, y) < kWashFrames && passes.at(x, y)[render::kAlpha] >= 1.0f &&
+                  passes.at(x, y)[render::kOutline] <= 0.0f;
+  return out;
+}
+
+}  // namespace emaki::bench
