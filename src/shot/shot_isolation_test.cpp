@@ -106,8 +106,7 @@ TEST_F(ShotIsolation, ShotsAndASynthesisRunAtOnceWithTheirOwnThreadCounts) {
     while (shots_running > 0 || rounds == 0) {
       const ScopedThreadCount all(0);
       const synth::Result r = small_synthesis();
-      if (!synth::test::same_bits(r.image, synth_expected.image))
-        failures[2] = "synthesis differs";
+      if (!synth::test::same_bits(r.image, synth_expected.image)) failures[2] = "synthesis differs";
       ++rounds;
     }
   });
