@@ -1,7 +1,8 @@
 // Fuzzes the batch-script quoting (src/farm/script_text.h). The first byte picks the function,
 // the rest is the value. What is accepted must read back exactly: a shell word unquotes (by the
 // POSIX single-quote rules) to the value and holds no line break; a directive value holds only
-// letters, digits and its allowed characters; a job name part has only safe bytes. Refusals are
+// letters, digits and its allowed characters; a Slurm pattern literal undoubles to the value; a
+// job name part has only safe bytes. Refusals are
 // emaki::Error; anything else that escapes, and every sanitizer report, is a bug.
 #include <cstddef>
 #include <cstdint>
@@ -43,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   const std::string value(reinterpret_cast<const char*>(data) + 1, size - 1);
   try {
-    switch (data[0] % 3) {
+    switch (data[0] % 4) {
       case 0: {
         const std::string word = emaki::farm::shell_word(value, "fuzz");
         if (word.find_first_of(std::string("\n\r\0", 3)) != std::string::npos) __builtin_trap();
@@ -56,6 +57,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (v != value || v.empty() || v[0] == '-') __builtin_trap();
         for (const char c : v)
           if (!plain(c) && allowed.find(c) == std::string_view::npos) __builtin_trap();
+        break;
+      }
+      case 2: {
+        // Undoubling the % gives the value back; no lone % is left to expand.
+        const std::string pattern = emaki::farm::slurm_pattern_literal(value, "fuzz");
+        std::string back;
+        for (std::size_t i = 0; i < pattern.size(); ++i) {
+          if (pattern[i] == '%' && (i + 1 == pattern.size() || pattern[++i] != '%'))
+            __builtin_trap();
+          back += pattern[i];
+        }
+        if (back != value || value.find('\\') != std::string::npos) __builtin_trap();
         break;
       }
       default: {

@@ -75,6 +75,16 @@ std::string directive_value(std::string_view value, const std::string& subject,
   return std::string(value);
 }
 
+std::string slurm_pattern_literal(std::string_view value, const std::string& subject) {
+  check_script_text(value, subject);
+  if (value.find('\\') != std::string_view::npos)
+    throw Error(subject, fmt::format("'{}' holds a backslash, which a Slurm --output path cannot",
+                                     echo(value)));
+  std::string out;
+  for (const char c : value) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
+}
+
 std::string job_name_part(std::string_view text) {
   std::string out;
   for (const char c : text) out += ascii_alnum(c) || c == '.' || c == '_' || c == '-' ? c : '_';

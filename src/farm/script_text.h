@@ -23,6 +23,11 @@ std::string shell_word(std::string_view value, const std::string& subject);
 std::string directive_value(std::string_view value, const std::string& subject,
                             std::string_view allowed);
 
+// `value` as the literal start of a Slurm filename pattern (sbatch's --output): every % doubled,
+// since Slurm expands %j, %A, ... anywhere in the path. A backslash is refused: it would turn
+// the pattern's expansion off. Refuses what check_script_text refuses.
+std::string slurm_pattern_literal(std::string_view value, const std::string& subject);
+
 // A job name made from free text: every byte that is not a letter, digit, '.', '_' or '-'
 // becomes '_', so any shot name yields a name sbatch, squeue and a directive take as it is.
 std::string job_name_part(std::string_view text);

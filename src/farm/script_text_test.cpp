@@ -89,6 +89,15 @@ TEST(ScriptText, DirectiveValuesTakeOnlyTheirCharacters) {
   EXPECT_NE(error_of([] { directive_value("", "outputs.folder", "._-"); }), "");
 }
 
+TEST(ScriptText, PercentSignsAreDoubledInSlurmPatterns) {
+  EXPECT_EQ(slurm_pattern_literal("/o/50%j %A x", "outputs.folder"), "/o/50%%j %%A x");
+  EXPECT_EQ(slurm_pattern_literal("/o/%%", "outputs.folder"), "/o/%%%%");
+  EXPECT_NE(error_of([] { slurm_pattern_literal("/o/a\\%j", "outputs.folder"); }).find("backslash"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { slurm_pattern_literal("/o/a\nb", "outputs.folder"); }).find("newline"),
+            std::string::npos);
+}
+
 TEST(ScriptText, JobNamesAreMadeFromAnyText) {
   EXPECT_EQ(job_name_part("sh010-1a2b"), "sh010-1a2b");
   EXPECT_EQ(job_name_part("a b\n$(x)%j\xff"), "a_b___x__j_");

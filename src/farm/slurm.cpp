@@ -162,8 +162,16 @@ std::map<std::string, std::string> queued_jobs(const Plan& plan, int shot,
   return out;
 }
 
+// sbatch's arguments for a shot's scripts: the farm folder as the working directory and the Slurm
+// log under it. As arguments, not #SBATCH lines, the folder's path may hold spaces; Slurm
+// expands % anywhere in --output (the working directory included), so its % are doubled.
+std::vector<std::string> sbatch_options(const std::string& farm, const std::string& subject) {
+  return {"--chdir=" + farm,
+          "--output=" + slurm_pattern_literal(farm, subject) + "/logs/slurm-%A_%a.log"};
+}
+
 // The #SBATCH lines of an array of tasks. Only values that pass directive_value reach them; the
-// farm folder does not (sbatch runs with --chdir=FARM and --output is relative to it).
+// farm folder does not (sbatch's own arguments carry --chdir and --output).
 std::string directives(const Plan& plan, const std::vector<const Task*>& tasks,
                        const std::vector<std::string>& depends, const SlurmOptions& o) {
   const Task& first = *tasks.front();
@@ -174,7 +182,6 @@ std::string directives(const Plan& plan, const std::vector<const Task*>& tasks,
       fmt::format("#SBATCH --job-name={}\n",
                   directive_value(job_name(plan, first.shot, first.kind), "job name", "._-:"));
   s += fmt::format("#SBATCH --array=0-{}\n", tasks.size() - 1);
-  s += "#SBATCH --output=logs/slurm-%A_%a.log\n";
   s += fmt::format("#SBATCH --cpus-per-task={}\n#SBATCH --mem={}M\n", threads, memory);
   using Option = std::tuple<const char*, const std::string*, const char*>;
   for (const auto& [name, value, allowed] :
@@ -202,8 +209,10 @@ std::string batch_script(const Plan& plan, const std::vector<const Task*>& tasks
   const std::string subject = echo_path(valid_utf8_or_marks(shot.path));
   const std::string farm_word = shell_word(farm, fmt::format("{}: outputs.folder", subject));
   std::string s = "#!/bin/sh\n" + directives(plan, tasks, depends, o);
-  s += "# Written by `emaki farm submit`, which runs it as `sbatch --chdir=FARM`: --output is\n";
-  s += "# relative to FARM. One case per task of the array.\n";
+  s += "# Written by `emaki farm submit`, which submits it as\n# sbatch --parsable";
+  for (const std::string& a : sbatch_options(farm, subject + ": outputs.folder"))
+    s += " " + shell_word(a, subject + ": outputs.folder");
+  s += " SCRIPT\n# One case per task of the array.\n";
   s += "case \"$SLURM_ARRAY_TASK_ID\" in\n";
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     std::string argv;
@@ -245,10 +254,11 @@ void check_nothing_queued(const Plan& plan, int shot, const std::map<std::string
       fmt::format("has jobs in the queue ({}); wait for them or run `emaki farm cancel`", ids));
 }
 
-// Submits a script from its farm folder: the script's relative --output lands there, and the
-// folder's path never has to fit an #SBATCH line.
-std::string sbatch(const std::string& script_path, const std::string& farm) {
-  const ProcessResult r = run_process({"sbatch", "--parsable", "--chdir=" + farm, script_path});
+std::string sbatch(const std::string& script_path, const std::vector<std::string>& options) {
+  std::vector<std::string> argv = {"sbatch", "--parsable"};
+  argv.insert(argv.end(), options.begin(), options.end());
+  argv.push_back(script_path);
+  const ProcessResult r = run_process(argv);
   if (r.exit_code != 0)
     throw Error("sbatch", fmt::format("refused '{}' ({}): {}", echo_path(script_path), r.exit_code,
                                       first_line(r.err)));
@@ -276,7 +286,7 @@ void scancel(const std::map<std::string, std::string>& job_names) {
 // cancelled and the error names jobs.tsv.
 std::string submit_array(const std::string& farm, const std::string& path,
                          const std::vector<const Task*>& tasks, const std::string& name) {
-  const std::string job = sbatch(path, farm);
+  const std::string job = sbatch(path, sbatch_options(farm, "outputs.folder"));
   try {
     append_jobs(farm, tasks, job);
   } catch (const Error& e) {

@@ -49,16 +49,16 @@ class SlurmTest : public ::testing::Test {
     test::write_small_painting(kData + "/stylit/source_style.png", painting());
     const std::string log = (dir_ / "log").string();
     fs::create_directories(log);
-    // sbatch --parsable --chdir=DIR SCRIPT: logs, prints the next job id, and with RUN set
-    // runs every element of the array from DIR as a node would.
+    // sbatch --parsable --chdir=DIR --output=PATTERN SCRIPT: logs, prints the next job id, and
+    // with log/run present runs every element of the array from DIR as a node would.
     write_file(
         dir_ / "bin/sbatch",
         "#!/bin/sh\nprintf '%s\\n' \"$*\" >>'" + log + "/sbatch'\nn=$(cat '" + log +
             "/next' 2>/dev/null || echo 100)\n" + "echo $((n + 1)) >'" + log + "/next'\n" +
             "if [ -f '" + log +
-            "/run' ]; then\n  last=$(sed -n 's/^#SBATCH --array=0-//p' \"$3\")\n" +
+            "/run' ]; then\n  last=$(sed -n 's/^#SBATCH --array=0-//p' \"$4\")\n" +
             "  i=0\n  while [ $i -le $last ]; do\n" +
-            "    (cd \"${2#--chdir=}\" && SLURM_ARRAY_TASK_ID=$i sh \"$3\" >/dev/null 2>&1)\n" +
+            "    (cd \"${2#--chdir=}\" && SLURM_ARRAY_TASK_ID=$i sh \"$4\" >/dev/null 2>&1)\n" +
             "    i=$((i + 1))\n  done\nfi\necho $n\n",
         true);
     write_file(dir_ / "bin/squeue",
@@ -152,7 +152,14 @@ TEST_F(SlurmTest, HostileButRepresentableNamesRunNoCommand) {
     const std::string log = slurp(farm + "/logs/" + t.id + ".log");
     EXPECT_NE(log.find("[" + p.shots[0].path + "]"), std::string::npos) << log;
   }
-  EXPECT_NE(logged("sbatch").find("--chdir=" + farm + " "), std::string::npos);
+  // The folder's path only in sbatch's arguments, its % doubled in the --output pattern.
+  std::string pattern = farm;
+  for (std::size_t at = 0; (at = pattern.find('%', at)) != std::string::npos; at += 2)
+    pattern.insert(at, "%");
+  EXPECT_NE(
+      logged("sbatch").find("--chdir=" + farm + " --output=" + pattern + "/logs/slurm-%A_%a.log "),
+      std::string::npos)
+      << logged("sbatch");
   for (const TaskStatus& st : status(p)) EXPECT_EQ(st.state, TaskState::kDone) << st.task->id;
 }
 

@@ -75,8 +75,12 @@ std::vector<std::string> write_previews(const Shot& shot, int first, int last) {
     written.push_back(paths.contact_sheet());
   }
   if (shot.outputs.mp4) {
-    encode_mp4(shot.outputs.folder + "/composite/frame_%04d.png", first, shot.source.fps,
-               shot.outputs.crf, paths.mp4());
+    // ffmpeg reads % anywhere in an image-sequence path as a pattern: the folder's are doubled.
+    std::string folder;
+    for (const char c : shot.outputs.folder)
+      folder += c == '%' ? std::string("%%") : std::string(1, c);
+    encode_mp4(folder + "/composite/frame_%04d.png", first, shot.source.fps, shot.outputs.crf,
+               paths.mp4());
     written.push_back(paths.mp4());
   }
   return written;
