@@ -3,7 +3,7 @@
 // source.objects[N].KEY. Internal to the shot module.
 #pragma once
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "scene/scene.h"
 
 namespace emaki::shot {

@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/image_io.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 #include "store/file_store.h"
 
 namespace emaki::shot {

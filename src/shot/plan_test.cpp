@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 #include "tests/small_painting.h"
 
 namespace emaki::shot {

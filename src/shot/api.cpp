@@ -1,4 +1,4 @@
-#include "shot/shot.h"
+#include "shot/api.h"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include "core/limits.h"
 #include "core/parallel.h"
 #include "shot/inputs.h"
-#include "shot/shot_file.h"
+#include "shot/parser.h"
 #include "store/file_store.h"
 #include "store/previews.h"
 
