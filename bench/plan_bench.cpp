@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "shot/api.h"
 #include "shot/plan.h"
-#include "shot/shot.h"
 
 namespace {
 

@@ -17,8 +17,8 @@
 #include "core/parallel.h"
 #include "memory_store.h"
 #include "pipeline/run.h"
+#include "shot/api.h"
 #include "shot/inputs.h"
-#include "shot/shot.h"
 
 int main(int argc, char** argv) {
   using namespace emaki;

@@ -51,8 +51,8 @@
 #include "pipeline/ghost.h"
 #include "pipeline/run.h"
 #include "render/passes.h"
+#include "shot/api.h"
 #include "shot/inputs.h"
-#include "shot/shot.h"
 #include "texture_measures.h"
 
 namespace {

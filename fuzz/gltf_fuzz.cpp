@@ -12,7 +12,7 @@
 #include "io/gltf_loader.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace emaki;

@@ -18,7 +18,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
-#include "shot/shot_file.h"
+#include "shot/parser.h"
 
 namespace {
 

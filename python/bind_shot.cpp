@@ -1,4 +1,4 @@
-// emaki.Shot: the shot API (src/shot/shot.h, src/shot/plan.h) from Python — the same calls the
+// emaki.Shot: the shot API (src/shot/api.h, src/shot/plan.h) from Python — the same calls the
 // command line and the farm submitter make, not a copy of them.
 #include <fmt/format.h>
 #include <pybind11/eval.h>
@@ -13,8 +13,8 @@
 #include "core/error.h"
 #include "python/bindings.h"
 #include "python/errors.h"
+#include "shot/api.h"
 #include "shot/plan.h"
-#include "shot/shot.h"
 
 namespace emaki::python {
 namespace {

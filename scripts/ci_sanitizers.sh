@@ -16,7 +16,7 @@ j=$(nproc)
 stage "asan build" sh -c "cmake --preset asan >/dev/null && cmake --build --preset asan -j$j >/dev/null"
 # Not the Slurm tests (label slurm): farm_slurm synthesizes 4 shots and took 699 s under ASan
 # (12 s of CPU per 160x90 frame-layer), and LeakSanitizer's tracer dies with signal 11 inside
-# Slurm job steps here. The farm code's plan is covered here by plan_test and shot_test.
+# Slurm job steps here. The farm code's plan is covered here by plan_test and api_test.
 # The asan test preset sets intercept_tls_get_addr=0: with glibc 2.36, GCC 12's LeakSanitizer
 # reads a bogus dynamic-TLS range left by a dlopen'ed library (glib, via OIIO) and its tracer dies
 # with signal 11 at exit ("Tracer caught signal 11", OutputSafety.ResumeAfterASizeChange...).

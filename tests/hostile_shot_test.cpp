@@ -17,8 +17,8 @@
 #include "core/image.h"
 #include "io/image_io.h"
 #include "render/passes.h"
+#include "shot/api.h"
 #include "shot/inputs.h"
-#include "shot/shot.h"
 #include "store/frame_sequence.h"
 
 namespace fs = std::filesystem;

@@ -19,8 +19,8 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "farm/slurm.h"
+#include "shot/api.h"
 #include "shot/plan.h"
-#include "shot/shot.h"
 
 namespace emaki::app {
 

@@ -11,7 +11,7 @@
 
 #include "apps/emaki/commands.h"
 #include "apps/emaki/frame_range.h"
-#include "apps/emaki/shot_options.h"
+#include "apps/emaki/staging_options.h"
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
@@ -25,14 +25,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The command's own options; the shot around the scene is ShotOptions'.
+// The command's own options; the shot around the scene is StagingOptions'.
 struct RenderCommandOptions {
   std::string scene_path, frames = "0", out_dir, clip;
   float fps = 24.0f, start_time = 0.0f;
   bool loop = false;
   bool previews = false, full_float = false, quiet = false;
   io::GltfOptions gltf;
-  ShotOptions shot{ShotSubject::kScene};
+  StagingOptions shot{StagingSubject::kScene};
 };
 
 void add_options(CLI::App& app, RenderCommandOptions& o) {

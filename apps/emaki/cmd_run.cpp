@@ -12,7 +12,7 @@
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_command.h"
 #include "core/error.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 
 namespace emaki::app {
 

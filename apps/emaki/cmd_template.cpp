@@ -8,7 +8,7 @@
 #include <string>
 
 #include "apps/emaki/commands.h"
-#include "apps/emaki/shot_options.h"
+#include "apps/emaki/staging_options.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "exemplar/reference_sphere.h"
@@ -20,12 +20,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The command's own options; the shot around the sphere is ShotOptions'.
+// The command's own options; the shot around the sphere is StagingOptions'.
 struct TemplateOptions {
   std::string out_dir, fit, sphere;
   float horizon = NAN;
   bool previews = false, full_float = false;
-  ShotOptions shot{ShotSubject::kReferenceSphere};
+  StagingOptions shot{StagingSubject::kReferenceSphere};
 };
 
 void add_options(CLI::App& app, TemplateOptions& o) {

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "apps/emaki/shot_options.h"
+#include "apps/emaki/staging_options.h"
 #include "pipeline/run.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 
 namespace emaki::app {
 

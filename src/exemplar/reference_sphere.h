@@ -11,7 +11,7 @@
 #include "core/image.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 namespace emaki::exemplar {
 

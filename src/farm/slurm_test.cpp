@@ -17,7 +17,7 @@
 
 #include "core/error.h"
 #include "farm/farm_state.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 #include "tests/small_painting.h"
 
 namespace emaki::farm {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/image.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "scene/scene.h"
 
 namespace emaki::pipeline {

@@ -13,7 +13,7 @@
 
 #include "core/image.h"
 #include "pipeline/frames.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 
 namespace emaki::pipeline {
 

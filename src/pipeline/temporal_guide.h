@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "synth/synthesizer.h"
 #include "temporal/advection.h"
 

@@ -10,7 +10,7 @@
 
 #include "render/raster.h"
 #include "scene/scene.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 namespace emaki::render::detail {
 

@@ -9,7 +9,7 @@
 #include "core/image.h"
 #include "render/passes.h"
 #include "scene/scene.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 namespace emaki::render {
 

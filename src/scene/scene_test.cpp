@@ -8,7 +8,7 @@
 #include <string>
 
 #include "io/gltf_loader.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 namespace emaki::scene {
 namespace {

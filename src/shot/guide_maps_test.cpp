@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "io/image_io.h"
 #include "shot/inputs.h"
-#include "shot/shot_file.h"
+#include "shot/parser.h"
 
 namespace emaki::shot {
 namespace {

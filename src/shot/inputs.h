@@ -9,7 +9,7 @@
 
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 
 namespace emaki::shot {
 

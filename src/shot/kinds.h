@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "composite/composite.h"
-#include "pipeline/shot.h"
-#include "scene/shot.h"
+#include "pipeline/shot_description.h"
+#include "scene/staging.h"
 
 namespace emaki::shot {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 
 namespace emaki::shot {
 namespace {

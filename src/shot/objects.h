@@ -7,7 +7,7 @@
 
 #include <cstdint>
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "scene/scene.h"
 
 namespace emaki::shot {

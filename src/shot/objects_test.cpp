@@ -14,9 +14,9 @@
 #include "io/gltf_loader.h"
 #include "render/passes.h"
 #include "scene/assembly.h"
+#include "shot/api.h"
 #include "shot/inputs.h"
-#include "shot/shot.h"
-#include "store/shot_manifest.h"
+#include "store/settings_manifests.h"
 
 namespace emaki::shot {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "shot/parse.h"
+#include "shot/parser_sections.h"
 
 namespace emaki::shot {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "scene/assembly.h"
-#include "shot/parse.h"
+#include "shot/parser_sections.h"
 
 namespace emaki::shot {
 

@@ -7,7 +7,7 @@
 #include "io/image_io.h"
 #include "io/input_file.h"
 #include "render/passes.h"
-#include "shot/parse.h"
+#include "shot/parser_sections.h"
 #include "store/frame_sequence.h"
 #include "store/studio_passes.h"
 

@@ -11,8 +11,8 @@
 #include "core/limits.h"
 #include "core/utf8.h"
 #include "io/image_io.h"
+#include "shot/api.h"
 #include "shot/objects.h"
-#include "shot/shot.h"
 #include "store/file_store.h"
 
 namespace emaki::shot {

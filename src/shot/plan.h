@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "shot/objects.h"
 
 namespace emaki::shot {

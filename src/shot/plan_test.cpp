@@ -11,8 +11,8 @@
 
 #include "core/error.h"
 #include "core/utf8.h"
+#include "shot/api.h"
 #include "shot/objects.h"
-#include "shot/shot.h"
 #include "tests/small_painting.h"
 #include "tests/textured_triangle.h"
 

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "shot/shot_file.h"
+#include "shot/parser.h"
 
 namespace emaki::shot {
 namespace {

@@ -14,7 +14,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
-#include "shot/shot.h"
+#include "shot/api.h"
 #include "synth/synthesizer.h"
 #include "synth/test_images.h"
 #include "tests/small_painting.h"

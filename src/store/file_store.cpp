@@ -14,7 +14,7 @@
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "store/field_file.h"
-#include "store/shot_manifest.h"
+#include "store/settings_manifests.h"
 
 namespace emaki::io {
 

@@ -1,6 +1,6 @@
 // The output folder of a shot: its layout (OutputPaths) and the Store that keeps layer results
 // and per-frame outputs there, every write atomic, each set of files under a manifest of the
-// settings that made it (store/shot_manifest.h).
+// settings that made it (store/settings_manifests.h).
 #pragma once
 
 #include <functional>
@@ -12,7 +12,7 @@
 
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "store/output_store.h"
 
 namespace emaki::io {
@@ -54,7 +54,7 @@ enum class StoreMode {
 };
 
 // Layer frames and composited frames each carry a manifest of the settings that made them
-// (store/shot_manifest.h). Files made under other settings are never read back: `kRun` deletes
+// (store/settings_manifests.h). Files made under other settings are never read back: `kRun` deletes
 // and redoes them on the first write, `kReadFinished` throws emaki::Error naming the folder.
 class FileStore : public pipeline::Store {
  public:

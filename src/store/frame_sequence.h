@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pipeline/frames.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "render/passes.h"
 
 namespace emaki::io {

@@ -12,7 +12,7 @@
 #include "io/image_io.h"
 #include "pipeline/run.h"
 #include "store/file_store.h"
-#include "store/shot_manifest.h"
+#include "store/settings_manifests.h"
 
 extern char** environ;
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 
 namespace emaki::io {
 

@@ -1,4 +1,4 @@
-#include "store/shot_manifest.h"
+#include "store/settings_manifests.h"
 
 #include <fmt/format.h>
 

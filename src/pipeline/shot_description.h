@@ -1,6 +1,6 @@
 // A shot, as the shot file describes it (docs/shot_file.md is the table of every key): where
 // the guide passes come from, the exemplars, the layers and how they are composited, and what
-// is written. Plain data, free of I/O: shot/shot_file.cpp fills it, pipeline/ runs it.
+// is written. Plain data, free of I/O: shot/parser.cpp fills it, pipeline/ runs it.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +10,7 @@
 #include "composite/composite.h"
 #include "exemplar/reference_sphere.h"
 #include "render/renderer.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 #include "temporal/confidence.h"
 
 namespace emaki::pipeline {

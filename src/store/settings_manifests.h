@@ -5,7 +5,7 @@
 // mixing old and new files.
 #pragma once
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "store/output_store.h"
 
 namespace emaki::io {

@@ -1,5 +1,5 @@
 // The options `emaki render` and `emaki template` share, and the helpers every command uses.
-#include "apps/emaki/shot_options.h"
+#include "apps/emaki/staging_options.h"
 
 #include <fmt/format.h>
 
@@ -70,13 +70,13 @@ constexpr SubjectTraits kReferenceSphereTraits{
     .outline_width_help = "outline width in pixels, [0, 16]",
 };
 
-const SubjectTraits& traits(ShotSubject subject) {
-  return subject == ShotSubject::kScene ? kSceneTraits : kReferenceSphereTraits;
+const SubjectTraits& traits(StagingSubject subject) {
+  return subject == StagingSubject::kScene ? kSceneTraits : kReferenceSphereTraits;
 }
 
 }  // namespace
 
-ShotOptions::ShotOptions(ShotSubject s)
+StagingOptions::StagingOptions(StagingSubject s)
     : subject(s),
       size(traits(s).size),
       aa(traits(s).aa),
@@ -164,9 +164,9 @@ bool parse_cli(CLI::App& app, const Args& in) {
   return false;
 }
 
-void ShotOptions::add_to(CLI::App& app) {
+void StagingOptions::add_to(CLI::App& app) {
   const SubjectTraits& t = traits(subject);
-  const bool scene = subject == ShotSubject::kScene;
+  const bool scene = subject == StagingSubject::kScene;
   app.add_option("--size", size, t.size_help)->capture_default_str();
   app.add_option("--aa", aa, "supersampling: N x N samples per pixel, [1, 4]")
       ->check(CLI::Range(1, 4))
@@ -224,7 +224,7 @@ void ShotOptions::add_to(CLI::App& app) {
       ->capture_default_str();
 }
 
-void ShotOptions::add_motion_options(CLI::App& app) {
+void StagingOptions::add_motion_options(CLI::App& app) {
   app.add_option("--orbit", orbit,
                  "camera turns this many degrees around the target over the frame range")
       ->capture_default_str();
@@ -237,7 +237,7 @@ void ShotOptions::add_motion_options(CLI::App& app) {
                  "use the glTF camera on this node index (animated with the clip)");
 }
 
-void ShotOptions::add_ground_placement_options(CLI::App& app) {
+void StagingOptions::add_ground_placement_options(CLI::App& app) {
   app.add_option("--ground-size", ground_size,
                  "side of the square ground plane, scene units, >= 0; 0 = 6x the subject")
       ->check(CLI::NonNegativeNumber)
@@ -246,14 +246,14 @@ void ShotOptions::add_ground_placement_options(CLI::App& app) {
                  "y of the ground plane; default: under the lowest point of the subject");
 }
 
-void ShotOptions::resolve(scene::ShotSpec& shot, render::RenderOptions& options) const {
-  CHECK(subject == ShotSubject::kScene);
+void StagingOptions::resolve(scene::ShotSpec& shot, render::RenderOptions& options) const {
+  CHECK(subject == StagingSubject::kScene);
   parse_size("--size", size, options.width, options.height);
   resolve_shot(shot, options);
 }
 
-void ShotOptions::resolve(exemplar::ReferenceSpec& spec, render::RenderOptions& options) const {
-  CHECK(subject == ShotSubject::kReferenceSphere);
+void StagingOptions::resolve(exemplar::ReferenceSpec& spec, render::RenderOptions& options) const {
+  CHECK(subject == StagingSubject::kReferenceSphere);
   scene::ShotSpec shot;
   resolve_shot(shot, options);
   spec.elevation_deg = shot.camera.elevation_deg;
@@ -264,7 +264,7 @@ void ShotOptions::resolve(exemplar::ReferenceSpec& spec, render::RenderOptions& 
   spec.background = shot.background;
 }
 
-void ShotOptions::resolve_shot(scene::ShotSpec& shot, render::RenderOptions& options) const {
+void StagingOptions::resolve_shot(scene::ShotSpec& shot, render::RenderOptions& options) const {
   const SubjectTraits& t = traits(subject);
   // Every float option, finite and in its documented range, before anything is loaded (those a
   // subject does not offer keep their valid defaults).

@@ -1,4 +1,4 @@
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 #include <algorithm>
 #include <cmath>

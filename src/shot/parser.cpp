@@ -1,6 +1,6 @@
 // The shot file's top level: size and nesting bounds, TOML syntax, the sections in order, and
 // the output folder.
-#include "shot/shot_file.h"
+#include "shot/parser.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "io/input_file.h"
-#include "shot/parse.h"
+#include "shot/parser_sections.h"
 
 namespace emaki::shot {
 

@@ -1,4 +1,4 @@
-#include "shot/shot_file.h"
+#include "shot/parser.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>

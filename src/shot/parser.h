@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 
 namespace emaki::shot {
 

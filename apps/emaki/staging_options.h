@@ -10,23 +10,23 @@
 #include "apps/emaki/commands.h"
 #include "exemplar/reference_sphere.h"
 #include "render/renderer.h"
-#include "scene/shot.h"
+#include "scene/staging.h"
 
 namespace emaki::app {
 
 // What the options frame. The subject decides which options there are, their defaults and their
-// bounds (shot_options.cpp lists them side by side).
-enum class ShotSubject {
+// bounds (staging_options.cpp lists them side by side).
+enum class StagingSubject {
   kScene,            // `emaki render`: a glTF scene; every option, camera motion included
   kReferenceSphere,  // `emaki template`: the reference sphere; exemplar::reference_shot aims
                      // the camera, so --elevation and --fov are its only camera options
 };
 
 // Raw option values as typed; resolve() checks them and fills the specs.
-struct ShotOptions {
-  explicit ShotOptions(ShotSubject subject);
+struct StagingOptions {
+  explicit StagingOptions(StagingSubject subject);
 
-  ShotSubject subject;
+  StagingSubject subject;
   // size, aa, elevation and fov default by subject; options a subject lacks keep these values.
   std::string size;
   int aa;

@@ -1,6 +1,6 @@
 // The shot API as every front end calls it: run, composite and flicker on a tiny shot, and the
 // neutral field names of a Request's errors.
-#include "shot/shot.h"
+#include "shot/api.h"
 
 #include <gtest/gtest.h>
 

@@ -13,11 +13,11 @@
 #include "pipeline/flicker.h"
 #include "pipeline/ghost.h"
 #include "pipeline/run.h"
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 
 namespace emaki::shot {
 
-// Reads and checks a shot file (shot/shot_file.h): nothing is written.
+// Reads and checks a shot file (shot/parser.h): nothing is written.
 pipeline::Shot open(const std::string& path);
 // The same from text; `path` names it in errors and anchors relative paths.
 pipeline::Shot open_text(std::string_view text, const std::string& path);

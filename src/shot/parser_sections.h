@@ -1,10 +1,10 @@
-// The parts of the shot file parser (shot_file.cpp reads the top level and calls these). Internal
+// The parts of the shot file parser (parser.cpp reads the top level and calls these). Internal
 // to the shot module.
 #pragma once
 
 #include <string>
 
-#include "pipeline/shot.h"
+#include "pipeline/shot_description.h"
 #include "shot/toml_reader.h"
 
 namespace emaki::shot {

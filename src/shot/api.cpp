@@ -1,4 +1,4 @@
-#include "shot/shot.h"
+#include "shot/api.h"
 
 #include <fmt/format.h>
 
@@ -7,8 +7,8 @@
 #include "core/parallel.h"
 #include "shot/inputs.h"
 #include "shot/memory.h"
+#include "shot/parser.h"
 #include "shot/plan.h"
-#include "shot/shot_file.h"
 #include "store/file_store.h"
 #include "store/previews.h"
 
