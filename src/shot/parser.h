@@ -21,7 +21,7 @@ inline constexpr int kMaxShotDepth = 64;
 // Parses and checks a shot file: syntax, keys, types, ranges, references between sections,
 // input files that must exist, and that the output folder can be written. Throws emaki::Error.
 // A `limits.max_pixels` in the file is the shot's pixel budget (pipeline::Shot::max_pixels),
-// applied while the file is parsed and during the shot's work (shot/shot.h), unless the command
+// applied while the file is parsed and during the shot's work (shot/api.h), unless the command
 // line pinned one (--max-pixels); it never changes the budget of anything else.
 pipeline::Shot load_shot(const std::string& path);
 
