@@ -28,7 +28,8 @@ Error error_of(const std::function<void()>& f) {
 }
 
 TEST(Memory, TheCallersLimitIsNamedByItsField) {
-  const Error e = error_of([] { check_memory(int64_t(3) << 30, int64_t(1) << 30, "s", "the run"); });
+  const Error e =
+      error_of([] { check_memory(int64_t(3) << 30, int64_t(1) << 30, "s", "the run"); });
   EXPECT_EQ(e.field(), "max_memory");
   EXPECT_EQ(e.message(),
             "the run needs about 3.0 GB of memory at its peak, more than the 1.0 GB allowed");
