@@ -69,11 +69,8 @@ void print_usage() {
 
 int main(int argc, char** argv) {
   using namespace emaki::app;
-  // No mallopt(M_MMAP_THRESHOLD) here: a fixed threshold (1 MB, set 2026-11-23 for peak RSS)
-  // also turns off glibc's adaptive one, and then every image of 1 MB or more was mapped anew and
-  // unmapped when freed. A 6-frame `emaki run` of the example took 1.48 M page faults (3.5-4.3
-  // system seconds) that way, 0.55 M without it: wall -9 %, peak RSS 674 -> 770 MB
-  // (docs/design/huge-pages.md). Huge pages took most of the rest.
+  // Large buffers on huge pages where the kernel takes advice (huge_pages.h,
+  // docs/design/huge-pages.md).
   restart_with_huge_pages(argv);
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     print_usage();
