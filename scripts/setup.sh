@@ -1,10 +1,10 @@
 #!/bin/sh
 # Installs the Debian 12 packages emaki builds and tests with (skips those already installed);
-# slurm-wlm and munge run the private test cluster of scripts/slurm/start.sh (daemons not started).
+# libgmock-dev: GTest's CMake config checks the gmock files exist. slurm-wlm and munge run the private test cluster of scripts/slurm/start.sh (daemons not started).
 set -e
 PKGS="build-essential cmake pkg-config libopenimageio-dev openimageio-tools libopencv-core-dev
 libopenexr-dev libtinygltf-dev libtbb-dev libcli11-dev libtomlplusplus-dev libfmt-dev
-libglm-dev libgtest-dev libgmock-dev libbenchmark-dev libpng-dev zlib1g-dev ffmpeg blender python3-numpy
+libglm-dev libgtest-dev libgmock-dev libpng-dev zlib1g-dev ffmpeg blender python3-numpy
 pybind11-dev python3-dev python3-pytest
 clang-14 libclang-rt-14-dev clang-format slurm-wlm slurm-client munge"
 missing=""
