@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages emaki builds and tests with (skips those already installed);
-# libgmock-dev: GTest's CMake config checks the gmock files exist. slurm-wlm and munge run the private test cluster of scripts/slurm/start.sh (daemons not started).
+# libgmock-dev because GTest's CMake config checks that the gmock files exist; slurm-wlm and
+# munge run the private test cluster of scripts/slurm/start.sh (daemons not started).
 set -e
 PKGS="build-essential cmake pkg-config libopenimageio-dev openimageio-tools libopencv-core-dev
 libopenexr-dev libtinygltf-dev libtbb-dev libcli11-dev libtomlplusplus-dev libfmt-dev
