@@ -236,12 +236,12 @@ TEST_F(PlanTest, MemoryEstimatesCountTheScene) {
   ASSERT_GT(opened_mb, 64.0);
   ASSERT_LT(opened_mb, 80.0);  // the texture once
   // Estimates are rounded up to 64 MB and carry a quarter of margin.
+  const std::string c = p.shots[0].name + ".", f = p.shots[1].name + ".";
   for (const char* kind : {"prepare", "composite.0-1", "passes.0-1"}) {
-    const double more = double(task(p, std::string("crowd.") + kind).memory_mb -
-                               task(p, std::string("fox.") + kind).memory_mb);
+    const double more = double(task(p, c + kind).memory_mb - task(p, f + kind).memory_mb);
     EXPECT_GE(more, 1.25 * opened_mb - 64 - 2) << kind;
   }
-  EXPECT_EQ(task(p, "crowd.previews").memory_mb, task(p, "fox.previews").memory_mb);
+  EXPECT_EQ(task(p, c + "previews").memory_mb, task(p, f + "previews").memory_mb);
 }
 }  // namespace
 }  // namespace emaki::shot
