@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "io/image_io.h"
+#include "tests/error_of.h"
 #include "tests/small_painting.h"
 
 namespace emaki::shot {
@@ -120,15 +121,7 @@ TEST_F(ShotApi, HatchingBlendChangesTheMixWithoutSynthesis) {
   EXPECT_EQ(again.report.reused, 4);
 }
 
-Error error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error";
-  return Error("", "");
-}
+using test::error_of;
 
 // A Request's errors name neutral fields that each front end spells its own way.
 TEST_F(ShotApi, RequestErrorsNameNeutralFields) {

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "shot/api.h"
+#include "tests/error_of.h"
 
 namespace emaki::shot {
 namespace {
@@ -17,15 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kData = EMAKI_TEST_DATA;
 
-Error error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error";
-  return Error("", "");
-}
+using test::error_of;
 
 TEST(Memory, TheCallersLimitIsNamedByItsField) {
   const Error e =
