@@ -34,6 +34,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <regex>
 #include <sstream>
@@ -279,6 +280,13 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
           std::strtof(value.c_str() + value.find('/') + 1, nullptr);
     } else if (key == "r") {
       l.temporal.reseed = x != 0.0f;
+    } else if (key == "a") {
+      l.temporal.anchor = int(x);
+    } else if (key == "as") {
+      l.temporal.anchor_sigma = x;
+    } else if (key == "ah") {
+      l.temporal.anchor_holes = x != 0.0f;
+
     } else {
       usage("bad modifier " + m);
     }
@@ -331,9 +339,14 @@ void run_variants(pipeline::Shot& shot, pipeline::Layer& layer, const pipeline::
     pipeline::RunOptions o;
     o.layers = {opt.layer};
     const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t c0 = std::clock();
     pipeline::run_shot(shot, src, exemplars, ci, v.store, o);
     v.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::fprintf(stderr, "temporal_bench: %s done in %.1f s\n", v.name.c_str(), v.seconds);
+    // CPU seconds of the whole process (every thread): comparable between variants on a loaded
+    // machine, where the wall time is not.
+    const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+    std::fprintf(stderr, "temporal_bench: %s done in %.1f s, %.1f CPU s (%.3f CPU s a frame)\n",
+                 v.name.c_str(), v.seconds, cpu, cpu / opt.frames);
   }
   layer = original;
 }

@@ -137,6 +137,15 @@ struct TemporalSpec {
   // A warm start drops the carried field where the temporal guide has no confidence (surface
   // hidden at t-1, the layer's guides changed): those pixels are searched afresh.
   bool reseed = false;
+  // The tone anchor (pipeline/tone_anchor.h, docs/design/tone-anchor.md): at each temporal frame
+  // a fresh transfer with every input halved `anchor` times (0: off); B'adv's low frequencies
+  // (a Gaussian of anchor_sigma pixels at that size) move to the fresh transfer's, so the chain
+  // cannot drift lighter or darker, and with anchor_holes the warm start takes the fresh field
+  // where the temporal guide has no confidence (uncovered surfaces get the painting's texture,
+  // not the leftovers of the carried field). Not in the shot file: measured defaults.
+  int anchor = 2;
+  float anchor_sigma = 4.0f;
+  bool anchor_holes = true;
 };
 
 struct SynthSpec {

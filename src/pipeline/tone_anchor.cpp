@@ -1,0 +1,148 @@
+#include "pipeline/tone_anchor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include "core/check.h"
+#include "synth/pyramid.h"
+#include "temporal/guide_change.h"
+
+namespace emaki::pipeline {
+
+namespace {
+
+Image<float> to_float(const synth::Plane& plane) {
+  return std::visit(
+      [](const auto& v) {
+        using T = std::remove_const_t<std::remove_pointer_t<decltype(v.data)>>;
+        const float scale =
+            std::is_same_v<T, float> ? 1.0f : 1.0f / float((1 << (8 * sizeof(T))) - 1);
+        Image<float> out(v.width, v.height, v.channels);
+        for (int y = 0; y < v.height; ++y)
+          for (int x = 0; x < v.width; ++x)
+            for (int c = 0; c < v.channels; ++c) out(x, y, c) = float(v(x, y, c)) * scale;
+        return out;
+      },
+      plane);
+}
+
+Image<float> halve(Image<float> im, int halvings) {
+  for (int i = 0; i < halvings; ++i) im = synth::downsample(im.cview());
+  return im;
+}
+
+// Bilinear, pixel centres aligned.
+float sample(const Image<float>& im, float x, float y, int c) {
+  x = std::clamp(x, 0.0f, float(im.width() - 1));
+  y = std::clamp(y, 0.0f, float(im.height() - 1));
+  const int x0 = int(x), y0 = int(y);
+  const int x1 = std::min(x0 + 1, im.width() - 1), y1 = std::min(y0 + 1, im.height() - 1);
+  const float fx = x - float(x0), fy = y - float(y0);
+  return (im(x0, y0, c) * (1 - fx) + im(x1, y0, c) * fx) * (1 - fy) +
+         (im(x0, y1, c) * (1 - fx) + im(x1, y1, c) * fx) * fy;
+}
+
+}  // namespace
+
+AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synth::Plane>& sources,
+                               int halvings) {
+  CHECK_GE(halvings, 1);
+  AnchorExemplar e;
+  e.halvings = halvings;
+  e.planes.push_back(halve(to_float(style), halvings));
+  for (const synth::Plane& p : sources) e.planes.push_back(halve(to_float(p), halvings));
+  return e;
+}
+
+Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
+                   const synth::Params& params, ImageView<const float> advected, int value_channels,
+                   const Image<float>& mask, float sigma) {
+  const int halvings = exemplar.halvings;
+  CHECK_EQ(exemplar.planes.size(), inputs.guides.size() + 1);
+  // The small inputs, kept alive while the small transfer reads them.
+  std::vector<Image<float>> keep;
+  keep.reserve(2 * inputs.guides.size());
+  auto small = [&](const synth::Plane& p) -> synth::Plane {
+    keep.push_back(halve(to_float(p), halvings));
+    return synth::Plane(keep.back().cview());
+  };
+  synth::Inputs s;
+  s.style = exemplar.planes[0].cview();
+  s.style_name = inputs.style_name;
+  for (std::size_t i = 0; i < inputs.guides.size(); ++i) {
+    const synth::GuidePair& g = inputs.guides[i];
+    synth::GuidePair h = g;
+    h.source = exemplar.planes[i + 1].cview();
+    h.target = small(g.target);
+    if (g.weight_map) h.weight_map = small(*g.weight_map);
+    s.guides.push_back(h);
+  }
+  // Too small to synthesize at that size: no anchor.
+  const int least = 2 * params.patch_size + 1;
+  const synth::Plane& t0 = s.guides.front().target;
+  if (std::min(synth::plane_width(t0), synth::plane_height(t0)) < least ||
+      std::min(synth::plane_width(s.style), synth::plane_height(s.style)) < least)
+    return {};
+  Image<float> small_mask;
+  if (!mask.empty()) {
+    Image<float> m(mask.width(), mask.height(), mask.channels());
+    for (int y = 0; y < m.height(); ++y)
+      for (int x = 0; x < m.width() * m.channels(); ++x) m.row(y)[x] = mask.row(y)[x];
+    small_mask = halve(std::move(m), halvings);
+    bool any = false;
+    for (int y = 0; y < small_mask.height() && !any; ++y)
+      for (int x = 0; x < small_mask.width() && !any; ++x) any = small_mask(x, y) > 0.5f;
+    if (!any) return {};
+    s.target_mask = small_mask.cview();
+  }
+  synth::Params p = params;
+  p.initial_nnf = {};
+  p.progress = nullptr;
+  synth::OutputRequest request;
+  request.nnf = true;
+  const synth::Result fresh = synth::synthesize(s, p, request);
+
+  // The difference, fresh minus carried, at the small size, low-passed inside the mask.
+  const int n = value_channels;
+  Image<float> carried(advected.width, advected.height, n);
+  for (int y = 0; y < advected.height; ++y)
+    for (int x = 0; x < advected.width; ++x)
+      for (int c = 0; c < n; ++c) carried(x, y, c) = advected(x, y, c);
+  carried = halve(std::move(carried), halvings);
+  const int sw = carried.width(), sh = carried.height();
+  CHECK_EQ(fresh.image.width(), sw);
+  Image<float> diff(sw, sh, n);
+  for (int y = 0; y < sh; ++y)
+    for (int x = 0; x < sw; ++x)
+      for (int c = 0; c < n; ++c) diff(x, y, c) = fresh.image(x, y, c) - carried(x, y, c);
+  const Image<float> smooth = temporal::low_pass(
+      diff.cview(), sigma, small_mask.empty() ? ImageView<const float>{} : small_mask.cview());
+
+  Anchor a;
+  Image<float>& out = a.target;
+  out.reset(advected.width, advected.height, n);
+  // The field, each small pixel's patch spread over the block it covers at full size.
+  a.nnf.reset(advected.width, advected.height, 2);
+  for (int y = 0; y < advected.height; ++y)
+    for (int x = 0; x < advected.width; ++x) {
+      const int xs = std::min(x >> halvings, sw - 1), ys = std::min(y >> halvings, sh - 1);
+      const int32_t fx0 = fresh.nnf(xs, ys, 0), fy0 = fresh.nnf(xs, ys, 1);
+      const bool in = fx0 >= 0 && fy0 >= 0;
+      a.nnf(x, y, 0) = in ? (fx0 << halvings) + (x - (xs << halvings)) : -1;
+      a.nnf(x, y, 1) = in ? (fy0 << halvings) + (y - (ys << halvings)) : -1;
+    }
+  const float fx = float(sw) / float(advected.width), fy = float(sh) / float(advected.height);
+  for (int y = 0; y < advected.height; ++y)
+    for (int x = 0; x < advected.width; ++x)
+      for (int c = 0; c < n; ++c) {
+        const float d =
+            sample(smooth, (float(x) + 0.5f) * fx - 0.5f, (float(y) + 0.5f) * fy - 0.5f, c);
+        out(x, y, c) = std::clamp(advected(x, y, c) + d, 0.0f, 1.0f);
+      }
+  return a;
+}
+
+}  // namespace emaki::pipeline

@@ -1,0 +1,37 @@
+// The tone anchor of a layer's temporal guide: B'adv with its low frequencies moved to those of a
+// small fresh transfer of the same frame, so the chain cannot drift lighter or darker than the
+// painting says the frame should be, while the texture it carries (the high frequencies) stays.
+#pragma once
+
+#include <vector>
+
+#include "core/image.h"
+#include "synth/synthesizer.h"
+
+namespace emaki::pipeline {
+
+// The exemplar side of the fresh transfer, halved once per layer: `inputs`'s style and source
+// guides, in that order.
+struct AnchorExemplar {
+  int halvings = 0;
+  std::vector<Image<float>> planes;
+};
+AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synth::Plane>& sources,
+                               int halvings);
+
+// `inputs`: the frame's main transfer without its temporal pair; `exemplar`: its exemplar side,
+// halved by anchor_exemplar; `params`: the layer's settings
+// for a whole-pyramid transfer (its seed included); `advected`: B'adv, value channels first;
+// `mask`: the layer's mask at the frame (empty: none). The fresh transfer runs with every input
+// halved exemplar.halvings times; the difference of the two, low-passed by `sigma` pixels at that
+// size and inside the mask, is added back at full size. Both members are empty when the frame or
+// the mask is too small to synthesize at that size.
+struct Anchor {
+  Image<float> target;  // the anchored B'adv (value channels)
+  Image<int32_t> nnf;   // the fresh transfer's field scaled to full size ((-1, -1) outside it)
+};
+Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
+                   const synth::Params& params, ImageView<const float> advected, int value_channels,
+                   const Image<float>& mask, float sigma);
+
+}  // namespace emaki::pipeline
