@@ -208,7 +208,7 @@ std::string batch_script(const Plan& plan, const std::vector<const Task*>& tasks
   const std::string farm = farm_folder(plan, first.shot);
   // Errors name the shot file; one whose path is not UTF-8 is named with '?' for its bad bytes.
   const std::string subject = echo_path(valid_utf8_or_marks(shot.path));
-  const std::string folder_subject = subject + ": " + shot_keys::kOutputsFolder;
+  const std::string folder_subject = fmt::format("{}: {}", subject, shot_keys::kOutputsFolder);
   const std::string farm_word = shell_word(farm, folder_subject);
   std::string s = "#!/bin/sh\n" + directives(plan, tasks, depends, o);
   s += "# Written by `emaki farm submit`, which submits it as\n# sbatch --parsable";
