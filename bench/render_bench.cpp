@@ -8,10 +8,12 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/performance.h"
 #include "io/gltf_loader.h"
 #include "render/renderer.h"
 
 int main(int argc, char** argv) {
+  emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   using namespace emaki;
   const std::string path =
       argc > 1 ? argv[1] : std::string(EMAKI_SOURCE_DIR) + "/examples/data/Fox.glb";

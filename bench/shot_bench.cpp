@@ -15,12 +15,14 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/performance.h"
 #include "memory_store.h"
 #include "pipeline/run.h"
 #include "shot/api.h"
 #include "shot/inputs.h"
 
 int main(int argc, char** argv) {
+  emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   using namespace emaki;
   int width = 1920, height = 1080, frames = 3, threads = 0;
   if (argc > 1 && std::sscanf(argv[1], "%dx%d", &width, &height) != 2) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/performance.h"
 #include "io/image_io.h"
 #include "synth/pyramid.h"
 #include "synth/synthesizer.h"
@@ -18,6 +19,7 @@
 using namespace emaki;
 
 int main(int argc, char** argv) {
+  emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   std::string dir = std::string(EMAKI_SOURCE_DIR) + "/examples/stylit";
   int repeat = 3, threads = 0;
   for (int i = 1; i + 1 < argc; i += 2) {

@@ -45,6 +45,7 @@
 #include "composite/composite.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/performance.h"
 #include "io/image_io.h"
 #include "memory_store.h"
 #include "pipeline/flicker.h"
@@ -466,6 +467,7 @@ void print_tone_table(const std::vector<Variant>& variants) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   const Options opt = parse(argc, argv);
   const ScopedThreadCount count(opt.threads);
   try {

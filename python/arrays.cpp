@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <atomic>
 #include <cstring>
 #include <limits>
 
@@ -12,8 +11,6 @@
 
 namespace emaki::python {
 namespace {
-
-std::atomic<int64_t> g_input_copies{0};
 
 // Channels per pixel an array may have: EXR files hold up to 64; the engine takes up to 4.
 constexpr int64_t kMaxArrayChannels = 1024;
@@ -77,7 +74,6 @@ void copy(ArrayPlane& a) {
   a.plane = copy.cview();
   a.copy = std::move(copy);
   a.needs_copy = false;
-  g_input_copies.fetch_add(1, std::memory_order_relaxed);
 }
 
 std::size_t sample_bytes(SampleType t) {
@@ -157,10 +153,6 @@ ArrayPlane array_plane(const py::handle& obj, const std::string& name) {
   check_copy_memory({&a});
   copy_layout(a);
   return a;
-}
-
-int64_t input_copies() {
-  return g_input_copies.load(std::memory_order_relaxed);
 }
 
 SampleType sample_type(const py::handle& dtype, const std::string& name, SampleType fallback) {

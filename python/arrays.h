@@ -1,8 +1,8 @@
 // numpy arrays <-> emaki images. An input array is seen in place through the buffer protocol
 // whenever its layout is one an ImageView can describe (rows at any positive stride, pixels and
 // channels packed, aligned): no copy. Any other layout (a transposed or channel-sliced view, a
-// negative stride) is copied once into an Image of the same dtype, and counted
-// (input_copies()). Results are new C-contiguous arrays.
+// negative stride) is copied once into an Image of the same dtype. Results are new C-contiguous
+// arrays.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -56,9 +56,6 @@ void copy_layout(ArrayPlane& a);
 
 // inspect_array, check_copy_memory and copy_layout for one array.
 ArrayPlane array_plane(const py::handle& obj, const std::string& name);
-
-// Layout copies array_plane made in this process (a debugging and testing aid).
-int64_t input_copies();
 
 // The dtype an argument names (None: `fallback`); raises emaki.InputError naming `name` unless
 // it is uint8, uint16 or float32.

@@ -76,20 +76,6 @@ Raises:
         'mask', 'patch_size', ...).
 )";
 
-// A Python error raised in a hook while the GIL was released, carried out of the engine.
-// Where the engine read the inputs of this thread's last call (the zero-copy test).
-struct LastCall {
-  int64_t layout_copies = 0;
-  int images_made = 0;
-  std::uintptr_t style = 0, mask = 0;
-  std::vector<std::pair<std::uintptr_t, std::uintptr_t>> guides;
-};
-thread_local LastCall t_last;
-
-std::uintptr_t address(const synth::Plane& p) {
-  return std::visit([](const auto& v) { return reinterpret_cast<std::uintptr_t>(v.data); }, p);
-}
-
 struct GuideArrays {
   ArrayPlane source, target;
   float weight = -1.0f;
@@ -195,22 +181,12 @@ synth::Result run_engine(const ArrayPlane& style, const std::vector<GuideArrays>
                      guides[k].weight});
   std::optional<synth::NamedPlane> named_mask;
   if (mask) named_mask = synth::NamedPlane{mask->plane, "mask"};
-  LastCall last;
-  for (const auto& g : guides)
-    last.layout_copies += (g.source.copy.index() != 0) + (g.target.copy.index() != 0);
-  last.layout_copies += (style.copy.index() != 0) + (mask && mask->copy.index() != 0);
 
   std::optional<py::gil_scoped_release> released(std::in_place);
   try {
     const ScopedThreadCount thread_count(threads);
     synth::RuledInputs ruled =
         synth::apply_ebsynth_rules({style.plane, "style"}, named, named_mask);
-    last.images_made = ruled.images_made();
-    last.style = address(ruled.inputs.style);
-    for (const auto& g : ruled.inputs.guides)
-      last.guides.push_back({address(g.source), address(g.target)});
-    if (ruled.inputs.target_mask) last.mask = address(*ruled.inputs.target_mask);
-    t_last = last;
     style_channels = synth::plane_channels(ruled.inputs.style);
     synth::Synthesizer synthesizer(ruled.inputs, params);
     ruled.release_guides();
@@ -276,16 +252,6 @@ py::object synthesize(const py::handle& style_obj, const py::sequence& guides_ob
   return py::tuple(out);
 }
 
-py::dict last_inputs() {
-  py::dict d;
-  d["layout_copies"] = t_last.layout_copies;
-  d["images_made"] = t_last.images_made;
-  d["style"] = t_last.style;
-  d["guides"] = t_last.guides;
-  d["mask"] = t_last.mask ? py::object(py::int_(t_last.mask)) : py::none();
-  return d;
-}
-
 }  // namespace
 
 void bind_synth(py::module_& m) {
@@ -297,15 +263,6 @@ void bind_synth(py::module_& m) {
         py::arg("extra_pass_3x3") = false, py::arg("vote") = "weighted", py::arg("seed") = 1,
         py::arg("threads") = 0, py::arg("nnf") = false, py::arg("error") = false,
         py::arg("dtype") = py::none(), py::arg("progress") = py::none());
-  m.def("_last_inputs", &last_inputs,
-        "_last_inputs() -> dict\n\nDebugging aid: where the engine read the inputs of this "
-        "thread's last synthesize() "
-        "call (data addresses, comparable with a.__array_interface__['data'][0]), how many "
-        "inputs the binding copied for their layout and how many images EbSynth's channel "
-        "rules made.");
-  m.def("_input_copies", &input_copies,
-        "_input_copies() -> int\n\nDebugging aid: how many input arrays were copied for their "
-        "layout in this process.");
 }
 
 }  // namespace emaki::python

@@ -2,6 +2,7 @@
 // renderer and the reference sphere. Everything runs the same C++ code as the command line.
 #include <pybind11/pybind11.h>
 
+#include "core/performance.h"
 #include "python/bindings.h"
 #include "python/errors.h"
 
@@ -17,6 +18,9 @@ PYBIND11_MODULE(emaki, m) {
       "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
       "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
   m.attr("__version__") = "0.1.0";
+  // The one performance switch (core/performance.h), as the command line applies it: huge-page
+  // advice on large images, SIMD kernels unless EMAKI_SIMD=scalar.
+  emaki::set_performance(emaki::performance_from_environment());
   // Each docstring starts with its own signature (Python types, as in emaki.pyi) instead of
   // pybind11's, which would show C++ handle types.
   py::options options;

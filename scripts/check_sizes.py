@@ -1,10 +1,15 @@
 #!/usr/bin/python3
-"""Size limits for the tracked C++ sources (src/ apps/ python/ fuzz/ bench/ tests/).
+"""Size limits for the tracked C++ and Python sources (src/ apps/ python/ fuzz/ bench/ tests/,
+and for Python also scripts/ and tools/).
 
   * no file over 600 lines;
-  * no function body (from its '{' line to its '}' line) over 80 lines, unless a comment
-    reaching into the 3 lines above the function's signature (a run of '//' lines counts
-    as one comment) says `long-function: <reason>`.
+  * no function body (C++: from its '{' line to its '}' line; Python: from its 'def' line to
+    its last line) over 80 lines, unless a comment reaching into the 3 lines above the
+    function's signature (a run of '//' or '#' lines counts as one comment) says
+    `long-function: <reason>`.
+
+tools/blender/ is left out until its add-on is split into a package of small modules (issue
+#29); today its largest function is 167 lines.
 
 Usage: /usr/bin/python3 scripts/check_sizes.py [--only PATH...] [--list]
   --only PATH...  check only the files at or under these paths (repo-relative);
@@ -23,10 +28,15 @@ initializers of variables are data.
 
 Test files (tests/ and *_test.cpp) get the file rule but the function rule only for their
 helpers: a gtest case body (TEST, TEST_F, TEST_P, TYPED_TEST) is a script of checks that
-reads top to bottom, and cutting it into helpers would hide what each case asserts.
+reads top to bottom, and cutting it into helpers would hide what each case asserts. The same
+holds for Python test files (test_*.py, or under a tests/ folder) and their test_* functions.
+
+Python functions (and methods, and functions inside functions, each counted on its own) are
+found with the ast module.
 """
 
 import argparse
+import ast
 import os
 import re
 import subprocess
@@ -35,6 +45,8 @@ import sys
 MAX_FILE_LINES = 600
 MAX_FUNCTION_LINES = 80
 ROOTS = ("src/", "apps/", "python/", "fuzz/", "bench/", "tests/")
+PYTHON_ROOTS = ROOTS + ("scripts/", "tools/")
+PYTHON_LEFT_OUT = ("tools/blender/",)
 MARKER = re.compile(r"long-function:\s*\S")
 TEST_MACROS = {"TEST", "TEST_F", "TEST_P", "TYPED_TEST", "TYPED_TEST_P"}
 # Words that take a parenthesised argument but are not a function's name.
@@ -97,18 +109,7 @@ def blank(text):
             i = end
             continue
         if c == '"':
-            raw = re.search(r"(?:u8|u|U|L)?R$", text[max(0, i - 3):i])
-            before = i - len(raw.group(0)) - 1 if raw else -1
-            if raw and (before < 0 or not re.match(r"\w", text[before])):
-                delim_end = text.find("(", i)
-                close = ")" + text[i + 1:delim_end] + '"'
-                end = text.find(close, delim_end)
-                end = n if end < 0 else end + len(close)
-            else:
-                end = i + 1
-                while end < n and text[end] != '"' and text[end] != "\n":
-                    end += 2 if text[end] == "\\" else 1
-                end += 1
+            end = string_end(text, i)
             body = text[i:end]
             out.append('""' + keep_newlines(body[2:]))
             line += body.count("\n")
@@ -129,6 +130,22 @@ def blank(text):
         out.append(c)
         i += 1
     return "".join(out), [(a, b, t) for a, b, t, _ in comments]
+
+
+def string_end(text, i):
+    """The index just past the string literal opening at text[i] == '"' (raw strings too)."""
+    n = len(text)
+    raw = re.search(r"(?:u8|u|U|L)?R$", text[max(0, i - 3):i])
+    before = i - len(raw.group(0)) - 1 if raw else -1
+    if raw and (before < 0 or not re.match(r"\w", text[before])):
+        delim_end = text.find("(", i)
+        close = ")" + text[i + 1:delim_end] + '"'
+        end = text.find(close, delim_end)
+        return n if end < 0 else end + len(close)
+    end = i + 1
+    while end < n and text[end] != '"' and text[end] != "\n":
+        end += 2 if text[end] == "\\" else 1
+    return end + 1
 
 
 def is_digit_separator(text, i):
@@ -395,22 +412,67 @@ def check_file(path, lister):
     return problems
 
 
+def python_comments(text):
+    """Runs of '#' comment lines as (first_line, last_line, text), like blank()'s comments."""
+    comments = []
+    for number, raw in enumerate(text.splitlines(), 1):
+        stripped = raw.strip()
+        if not stripped.startswith("#"):
+            continue
+        if comments and comments[-1][1] == number - 1:
+            first, _, body = comments[-1]
+            comments[-1] = (first, number, body + "\n" + stripped)
+        else:
+            comments.append((number, number, stripped))
+    return comments
+
+
+def check_python_file(path, lister):
+    problems = []
+    with open(path, encoding="utf-8", errors="replace") as f:
+        text = f.read()
+    lines = text.count("\n") + (0 if text.endswith("\n") or not text else 1)
+    if lines > MAX_FILE_LINES:
+        problems.append((path, 0, f"{path}: {lines} lines (max {MAX_FILE_LINES})"))
+    name = os.path.basename(path)
+    is_test = name.startswith("test_") or "/tests/" in "/" + path
+    comments = python_comments(text)
+    for node in ast.walk(ast.parse(text, filename=path)):
+        if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        length = node.end_lineno - node.lineno + 1
+        lister.append((length, f"{path}:{node.lineno}: {node.name}"))
+        if length <= MAX_FUNCTION_LINES or (is_test and node.name.startswith("test_")):
+            continue
+        start = min([node.lineno] + [d.lineno for d in node.decorator_list])
+        if marked(comments, start):
+            continue
+        problems.append((path, node.lineno, f"{path}:{node.lineno}: function {node.name} is "
+                                            f"{length} lines (max {MAX_FUNCTION_LINES})"))
+    return problems
+
+
+def tracked(patterns, roots, left_out=()):
+    files = subprocess.run(["git", "ls-files"] + patterns, check=True, text=True,
+                           capture_output=True).stdout.split()
+    return [f for f in files if f.startswith(roots) and not f.startswith(left_out)]
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", metavar="PATH", help="check only these paths")
     parser.add_argument("--list", action="store_true", help="print every function's length")
     args = parser.parse_args()
     os.chdir(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-    files = subprocess.run(["git", "ls-files", "*.cpp", "*.h"], check=True, text=True,
-                           capture_output=True).stdout.split()
-    files = [f for f in files if f.startswith(ROOTS)]
+    files = tracked(["*.cpp", "*.h"], ROOTS) + tracked(["*.py"], PYTHON_ROOTS, PYTHON_LEFT_OUT)
     if args.only:
         wanted = [os.path.normpath(p) for p in args.only]
         files = [f for f in files if any(f == w or f.startswith(w.rstrip("/") + "/")
                                          for w in wanted)]
     problems, lister = [], []
     for path in sorted(files):
-        problems += check_file(path, lister)
+        check = check_python_file if path.endswith(".py") else check_file
+        problems += check(path, lister)
     if args.list:
         for length, where in sorted(lister, key=lambda x: -x[0]):
             print(f"{length:5d} {where}")
@@ -418,7 +480,9 @@ def main():
         print(message)
     if problems:
         return 1
-    print(f"check_sizes: {len(files)} files within {MAX_FILE_LINES} lines, "
+    python = sum(f.endswith(".py") for f in files)
+    print(f"check_sizes: {len(files)} files ({len(files) - python} C++, {python} Python) within "
+          f"{MAX_FILE_LINES} lines, "
           f"functions within {MAX_FUNCTION_LINES}")
     return 0
 

@@ -10,6 +10,7 @@
 #include "apps/emaki/huge_pages.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/performance.h"
 
 namespace emaki::app {
 
@@ -72,6 +73,9 @@ int main(int argc, char** argv) {
   // Large buffers on huge pages where the kernel takes advice (huge_pages.h,
   // docs/design/huge-pages.md).
   restart_with_huge_pages(argv);
+  // The one performance switch (core/performance.h): huge-page advice on large images, SIMD
+  // kernels unless EMAKI_SIMD=scalar.
+  emaki::set_performance(emaki::performance_from_environment());
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     print_usage();
     return argc < 2 ? 2 : 0;

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/shot_keys.h"
 
 namespace emaki::composite {
 
@@ -18,9 +19,8 @@ float clamp01(float v) {
 void check_size(const std::string& layer, const char* what, ImageView<const float> v, int width,
                 int height) {
   if (v.width != width || v.height != height)
-    throw Error(
-        fmt::format("layers.{}", layer),
-        fmt::format("{} is {}x{}, the output is {}x{}", what, v.width, v.height, width, height));
+    throw Error(shot_keys::layer(layer), fmt::format("{} is {}x{}, the output is {}x{}", what,
+                                                     v.width, v.height, width, height));
 }
 }  // namespace
 
@@ -145,13 +145,13 @@ Image<float> color_layer(const LayerInput& layer, int width, int height) {
   check_size(layer.name, "its value image", layer.value, width, height);
   if (look.source == ColorSource::kAlbedo) {
     if (layer.albedo.empty())
-      throw Error(fmt::format("layers.{}.color", layer.name),
+      throw Error(shot_keys::layer_key(layer.name, shot_keys::kColor),
                   "'albedo' needs the albedo pass, which this source does not have");
     check_size(layer.name, "the albedo pass", layer.albedo, width, height);
     CHECK_GE(layer.albedo.channels, 3);
   }
   if (look.source == ColorSource::kGradient && look.gradient.empty())
-    throw Error(fmt::format("layers.{}.gradient", layer.name), "needs at least one stop");
+    throw Error(shot_keys::layer_key(layer.name, shot_keys::kGradient), "needs at least one stop");
   const Filters& f = look.filters;
   const int n = layer.value_channels;
   CHECK(n == 1 || n == 3);
@@ -202,7 +202,7 @@ Image<float> color_layer(const LayerInput& layer, int width, int height) {
 Image<float> paper_image(const Paper& paper, int width, int height) {
   Image<float> out(width, height, 3);
   const ImageView<const float> t = paper.texture;
-  if (paper.scale <= 0.0f) throw Error("compositing.paper_scale", "must be > 0");
+  if (paper.scale <= 0.0f) throw Error(shot_keys::kPaperScale, "must be > 0");
   parallel_rows(height, 16, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x) {

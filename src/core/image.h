@@ -5,9 +5,8 @@
 // are explicit (clone()).
 #pragma once
 
-#include <sys/mman.h>
-
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -24,20 +23,12 @@ namespace emaki {
 inline constexpr std::size_t kRowAlign = 64;
 
 namespace detail {
-// Images of this size or more ask the kernel for transparent huge pages before their first
-// touch: where its mode is "madvise" a large image is then faulted in 2 MB at a time instead of
-// 4 KB (the Python module's only way to them: `emaki` itself also restarts with glibc's tunable,
-// apps/emaki/huge_pages.h). Pixels do not change, only how their memory is mapped.
-// Inline, so that every library holding images (also the dlopen'ed OpenImageIO module) has it.
-inline constexpr std::size_t kHugePageAdviceBytes = std::size_t(4) << 20;
-inline void advise_huge_pages(void* p, std::size_t bytes) {
-  if (bytes < kHugePageAdviceBytes) return;
-  constexpr std::uintptr_t kPage = 4096;  // the advice covers whole pages inside the block
-  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) / kPage * kPage;
-  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(p) + bytes) / kPage * kPage;
-  // Advice only: a kernel without transparent huge pages refuses it, and nothing changes then.
-  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
+// Called with each new image's block before its first touch, when set. How the memory is
+// mapped is a front end's choice (core/performance.h sets it), not the image type's. Inline, so
+// that every library holding images (also the dlopen'ed OpenImageIO module, which is handed
+// the front end's hook when it loads) has one.
+using ImageBlockHook = void (*)(void* block, std::size_t bytes);
+inline std::atomic<ImageBlockHook> image_block_hook{nullptr};
 }  // namespace detail
 
 template <typename T>
@@ -88,7 +79,9 @@ class Image {
     T* mem = static_cast<T*>(std::aligned_alloc(kRowAlign, bytes));
     if (mem == nullptr) throw std::bad_alloc();
     mem_.reset(mem);
-    detail::advise_huge_pages(mem, bytes);
+    if (const detail::ImageBlockHook hook =
+            detail::image_block_hook.load(std::memory_order_relaxed))
+      hook(mem, bytes);
     width_ = width;
     height_ = height;
     channels_ = channels;

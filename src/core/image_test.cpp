@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "core/performance.h"
+
 namespace emaki {
 namespace {
 
@@ -39,10 +41,23 @@ std::string vm_flags_at(const void* p) {
 TEST(Image, LargeImagesAskForHugePagesWhereTheKernelTakesAdvice) {
   if (slurp("/sys/kernel/mm/transparent_hugepage/enabled").find("[madvise]") == std::string::npos)
     GTEST_SKIP() << "the kernel's THP mode is not madvise";
+  const Performance before = performance();
+  Performance advice = before;
+  advice.huge_page_advice = true;  // as the front ends set it
+  set_performance(advice);
   const Image<float> large(1024, 1024, 4);  // 16 MB
+  set_performance(before);
   EXPECT_NE(vm_flags_at(large.row(512)).find(" hg"), std::string::npos)
       << vm_flags_at(large.row(512));
   EXPECT_EQ(large(100, 700, 3), 0.0f);  // still zero-filled
+}
+
+// Without a front end's setting, an image is plain memory: no advice.
+TEST(Image, NoAdviceUnlessAFrontEndAsksForIt) {
+  ASSERT_FALSE(performance().huge_page_advice);
+  EXPECT_EQ(detail::image_block_hook.load(), nullptr);
+  const Performance env = performance_from_environment();
+  EXPECT_TRUE(env.huge_page_advice);
 }
 
 TEST(Image, AdviceOnlyFromTheThresholdAndOnlyOnWholePages) {

@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/shot_keys.h"
 #include "core/utf8.h"
 #include "farm/farm_state.h"
 #include "farm/process.h"
@@ -207,11 +208,12 @@ std::string batch_script(const Plan& plan, const std::vector<const Task*>& tasks
   const std::string farm = farm_folder(plan, first.shot);
   // Errors name the shot file; one whose path is not UTF-8 is named with '?' for its bad bytes.
   const std::string subject = echo_path(valid_utf8_or_marks(shot.path));
-  const std::string farm_word = shell_word(farm, fmt::format("{}: outputs.folder", subject));
+  const std::string folder_subject = fmt::format("{}: {}", subject, shot_keys::kOutputsFolder);
+  const std::string farm_word = shell_word(farm, folder_subject);
   std::string s = "#!/bin/sh\n" + directives(plan, tasks, depends, o);
   s += "# Written by `emaki farm submit`, which submits it as\n# sbatch --parsable";
-  for (const std::string& a : sbatch_options(farm, subject + ": outputs.folder"))
-    s += " " + shell_word(a, subject + ": outputs.folder");
+  for (const std::string& a : sbatch_options(farm, folder_subject))
+    s += " " + shell_word(a, folder_subject);
   s += " SCRIPT\n# One case per task of the array.\n";
   s += "case \"$SLURM_ARRAY_TASK_ID\" in\n";
   for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -286,7 +288,7 @@ void scancel(const std::map<std::string, std::string>& job_names) {
 // cancelled and the error names jobs.tsv.
 std::string submit_array(const std::string& farm, const std::string& path,
                          const std::vector<const Task*>& tasks, const std::string& name) {
-  const std::string job = sbatch(path, sbatch_options(farm, "outputs.folder"));
+  const std::string job = sbatch(path, sbatch_options(farm, shot_keys::kOutputsFolder));
   try {
     append_jobs(farm, tasks, job);
   } catch (const Error& e) {

@@ -119,6 +119,9 @@ const OiioBackend& oiio_backend(const std::string& subject) {
       }
       using Fn = const OiioBackend* (*)();
       if (auto fn = reinterpret_cast<Fn>(dlsym(h, "emaki_oiio_backend"))) {
+        using SetHook = void (*)(emaki::detail::ImageBlockHook);
+        if (auto set = reinterpret_cast<SetHook>(dlsym(h, "emaki_oiio_set_image_hook")))
+          set(emaki::detail::image_block_hook.load());
         backend = fn();
         return;
       }

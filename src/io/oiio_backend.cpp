@@ -286,3 +286,9 @@ const OiioBackend kBackend{read_impl, list_impl, write_impl};
 extern "C" const emaki::io::detail::OiioBackend* emaki_oiio_backend() {
   return &emaki::io::detail::kBackend;
 }
+
+// The loading program's image hook (core/image.h), handed over on loading: this module holds
+// its own copy of the inline variable, and images read here follow the front end's settings.
+extern "C" void emaki_oiio_set_image_hook(emaki::detail::ImageBlockHook hook) {
+  emaki::detail::image_block_hook.store(hook);
+}

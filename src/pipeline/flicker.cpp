@@ -6,6 +6,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
+#include "core/shot_keys.h"
 #include "render/passes.h"
 
 namespace emaki::pipeline {
@@ -56,7 +57,7 @@ SequenceFlicker measure_flicker(const Layer& layer, const FrameSource& frames, c
   CHECK_LT(first, last);
   for (int f = first; f <= last; ++f)
     if (!store.has_layer(layer, f))
-      throw Error("layers." + layer.name, fmt::format("frame {} is not synthesized yet", f));
+      throw Error(shot_keys::layer(layer.name), fmt::format("frame {} is not synthesized yet", f));
   const int value_channels = layer.single_colour ? 1 : 3;
   SequenceFlicker mean;
   Image<float> prev = store.read_layer(layer, first), prev_passes = frames.passes(first);

@@ -6,6 +6,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
+#include "core/shot_keys.h"
 #include "pipeline/temporal_guide.h"
 #include "render/passes.h"
 
@@ -78,10 +79,11 @@ GhostStats measure_ghost(const Layer& layer, const FrameSource& frames, const St
                          const std::function<void(const FrameGhost&)>& each) {
   CHECK_LT(first, last);
   if (!layer.temporal.enabled)
-    throw Error("layers." + layer.name, "is not temporal (temporal = false): it has no ghosts");
+    throw Error(shot_keys::layer(layer.name),
+                "is not temporal (temporal = false): it has no ghosts");
   for (int f = first; f <= last; ++f)
     if (!store.has_layer(layer, f))
-      throw Error("layers." + layer.name, fmt::format("frame {} is not synthesized yet", f));
+      throw Error(shot_keys::layer(layer.name), fmt::format("frame {} is not synthesized yet", f));
   GhostStats total;
   Image<float> prev = store.read_layer(layer, first), prev_passes = frames.passes(first);
   for (int f = first + 1; f <= last; ++f) {

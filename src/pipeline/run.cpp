@@ -10,6 +10,7 @@
 #include "composite/composite.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "core/shot_keys.h"
 #include "pipeline/temporal_guide.h"
 #include "pipeline/tone_anchor.h"
 #include "render/passes.h"
@@ -42,7 +43,7 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     p.style = composite::touch(ex.painting.cview(), layer.channel);
   } else {
     if (ex.painting.channels() < 3)
-      throw Error(fmt::format("layers.{}.single_colour", layer.name),
+      throw Error(shot_keys::layer_key(layer.name, shot_keys::kSingleColour),
                   "false needs an RGB painting, its exemplar's painting is grey");
     p.style = extract(ex.painting.cview(), 0, 3);
   }
@@ -499,7 +500,7 @@ int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInpu
     for (const Layer& l : shot.layers) {
       if (!store.has_layer(l, f))
         throw Error(
-            fmt::format("layers.{}", l.name),
+            shot_keys::layer(l.name),
             fmt::format("frame {} has not been synthesized yet (run `emaki run` first)", f));
       values.push_back(store.read_layer(l, f));
     }

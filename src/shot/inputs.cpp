@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/shot_keys.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
 #include "shot/objects.h"
@@ -19,26 +20,6 @@ using pipeline::Shot;
 
 namespace {
 
-// The shot file's spelling of each neutral field (Error::Field) the loaders below can meet: the
-// one place a field becomes a key. `section` is the table the field sits in; an exemplar's key
-// takes its name ("exemplars.NAME.sphere").
-struct ShotKey {
-  const char* field;
-  const char* section;
-  const char* key;
-};
-constexpr ShotKey kShotKeys[] = {
-    {"frames", "source", "frames"},
-    {"sequence", "source", "sequence"},
-    {"fps", "source", "fps"},
-    {"clip", "source", "clip"},
-    {"start", "source", "start"},
-    {"aa", "source", "aa"},
-    {"gltf_node", "source", "camera.gltf_node"},
-    {"sphere", "exemplars", "sphere"},
-    {"horizon", "exemplars", "horizon"},
-};
-
 // Rethrows `e` named by its shot file key under `table` ("source" or "exemplars.NAME"). An error
 // that names no field (a file path) is rethrown as it is; a field with no key here keeps its
 // neutral name, which is true, rather than a guessed key, and is marked as spelled so that the
@@ -46,7 +27,7 @@ constexpr ShotKey kShotKeys[] = {
 [[noreturn]] void rethrow_as_key(const Error& e, const std::string& table) {
   if (e.field().empty()) throw e;
   const std::string section = table.substr(0, table.find('.'));
-  for (const ShotKey& k : kShotKeys)
+  for (const shot_keys::FieldKey& k : shot_keys::kFieldKeys)
     if (e.field() == k.field && section == k.section) throw e.respelled(table + "." + k.key);
   throw e.respelled(e.subject());
 }

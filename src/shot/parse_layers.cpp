@@ -8,7 +8,7 @@
 namespace emaki::shot {
 
 void parse_exemplar(const Reader& r, const PathContext& ctx, pipeline::Exemplar& e) {
-  e.kind = r.choice("kind", pipeline::ExemplarKind::kMatcap, kExemplarKinds);
+  e.kind = r.choice("kind", e.kind, kExemplarKinds);
   e.painting = ctx.input_file(r, "painting", true);
   if (e.kind == pipeline::ExemplarKind::kKeyframe) {
     for (const char* k : {"sphere", "elevation", "horizon", "fov", "light", "softness", "ground",
@@ -34,7 +34,8 @@ void parse_exemplar(const Reader& r, const PathContext& ctx, pipeline::Exemplar&
     throw Error(r.key_path("light"), "must not be [0, 0, 0]");
   ref.light.softness_deg = r.real("softness", ref.light.softness_deg);
   ref.ground = r.boolean("ground", ref.ground);
-  const composite::Color g = r.color("ground_color", {0.8f, 0.8f, 0.8f});
+  const glm::vec3 ground = ref.ground_color;
+  const composite::Color g = r.color("ground_color", {ground.r, ground.g, ground.b});
   ref.ground_color = {g.r, g.g, g.b};
   e.aa = r.integer("aa", e.aa);
 }
@@ -93,11 +94,11 @@ std::vector<pipeline::GuideSpec> parse_guides(const Reader& r, const PathContext
                   "use normal, diffuse, shadow, outline, albedo, ...");
     if (const toml::table* sub = g.node(pass)->as_table()) {
       const Reader m(*sub, g.key_path(pass), "layers.NAME.guides.PASS");
-      pipeline::GuideSpec spec{pass, m.real("weight", 1.0f)};
+      pipeline::GuideSpec spec{pass, m.real("weight", pipeline::GuideSpec{}.weight)};
       if (m.has("map")) parse_weight_map(m, ctx, spec);
       guides.push_back(spec);
     } else {
-      guides.push_back({pass, g.real(pass, 1.0f)});
+      guides.push_back({pass, g.real(pass, pipeline::GuideSpec{}.weight)});
     }
   }
   if (guides.empty()) throw Error(r.key_path("guides"), "needs at least one pass");
@@ -114,7 +115,7 @@ void parse_synthesis(const Reader& r, pipeline::SynthSpec& s) {
     throw Error(r.key_path("pyramid_levels"), "must be >= 1, or -1 for automatic");
   s.search_vote_iters = r.integer("search_vote_iters", s.search_vote_iters);
   s.patch_match_iters = r.integer("patch_match_iters", s.patch_match_iters);
-  s.seed = uint64_t(r.integer("seed", 1));
+  s.seed = uint64_t(r.integer("seed", int(s.seed)));
 }
 
 std::vector<float> unit_numbers(const Reader& r, const toml::array& stop) {
@@ -186,15 +187,15 @@ void parse_filters(const Reader& r, composite::Filters& f) {
     f.out_black = v[0], f.out_white = v[1];
   }
   f.tint = r.color("tint", f.tint);
-  f.hue_deg = r.real("hue", 0.0f);
-  f.saturation = r.real("saturation", 1.0f);
-  f.opacity = r.real("opacity", 1.0f);
+  f.hue_deg = r.real("hue", f.hue_deg);
+  f.saturation = r.real("saturation", f.saturation);
+  f.opacity = r.real("opacity", f.opacity);
 }
 
 }  // namespace
 
 void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l) {
-  l.kind = r.choice("kind", pipeline::LayerKind::kCustom, kLayerKinds);
+  l.kind = r.choice("kind", l.kind, kLayerKinds);
   const KindDefaults d = kind_defaults(l.kind);
   l.exemplar = r.string("exemplar", "");
   if (l.exemplar.empty())
@@ -205,12 +206,11 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   if (const toml::table* t = r.table("guides")) l.guides = parse_guides(r, ctx, *t);
   if (l.guides.empty()) throw Error(r.key_path("guides"), "is required for a 'custom' layer");
   parse_synthesis(r, l.synth);
-  l.single_colour = r.boolean("single_colour", true);
-  l.channel = r.choice("channel", -1, kTouchChannels);
-  l.temporal.enabled = r.boolean("temporal", true);
+  l.single_colour = r.boolean("single_colour", l.single_colour);
+  l.channel = r.choice("channel", l.channel, kTouchChannels);
+  l.temporal.enabled = r.boolean("temporal", l.temporal.enabled);
   l.temporal.weight = r.real("temporal_weight", d.temporal_weight);
-  l.temporal.guide =
-      r.choice("advection", pipeline::AdvectionGuide::kRestPosition, kAdvectionGuides);
+  l.temporal.guide = r.choice("advection", l.temporal.guide, kAdvectionGuides);
   l.temporal.confidence = r.boolean("temporal_confidence", l.temporal.confidence);
   l.temporal.uniformity = r.real("temporal_uniformity", d.temporal_uniformity);
   l.temporal.anchor_holes = d.temporal_anchor_holes;
@@ -221,7 +221,7 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   l.mask.kind = r.choice("mask", d.mask.kind, kMaskKinds);
   l.mask.dilate = r.real("mask_dilate", l.mask.dilate);
   l.mask.threshold = r.real("mask_threshold", l.mask.threshold);
-  l.order = r.integer("order", 0);
+  l.order = r.integer("order", l.order);
   l.look = d.look;
   parse_colour(r, l.look);
   parse_filters(r, l.look.filters);

@@ -12,10 +12,10 @@ namespace emaki::shot {
 namespace {
 
 // `scale`: one number for all three axes, or [x, y, z]; each within the schema's range.
-glm::vec3 parse_scale(const Reader& r) {
+glm::vec3 parse_scale(const Reader& r, glm::vec3 fallback) {
   const toml::node* n = r.node("scale");
-  if (!n) return glm::vec3(1.0f);
-  if (!n->is_array()) return glm::vec3(r.real("scale", 1.0f));
+  if (!n) return fallback;
+  if (!n->is_array()) return glm::vec3(r.real("scale", fallback.x));
   const std::vector<float> v = r.numbers("scale", 3);
   const KeySpec* k = find_key("source.objects[N].scale");
   for (float x : v)
@@ -30,11 +30,11 @@ pipeline::SceneObject parse_object(const Reader& r, const PathContext& ctx, int 
   o.scene = ctx.input_file(r, "scene", true);
   o.translate = r.vec3("translate", o.translate);
   o.rotate_deg = r.vec3("rotate", o.rotate_deg);
-  o.scale = parse_scale(r);
+  o.scale = parse_scale(r, o.scale);
   o.velocity = r.vec3("velocity", o.velocity);
-  o.clip = r.string("clip", "");
-  o.start = r.real("start", 0.0f);
-  o.loop = r.boolean("loop", false);
+  o.clip = r.string("clip", o.clip);
+  o.start = r.real("start", o.start);
+  o.loop = r.boolean("loop", o.loop);
   o.id = r.integer("id", default_id);
   const double most = find_key("source.objects[N].id")->hi;
   if (o.id > most)

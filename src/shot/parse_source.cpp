@@ -72,7 +72,7 @@ void parse_frames(const Reader& r, pipeline::Source& s) {
 }
 
 void parse_camera(const Reader& r, scene::CameraSpec& c) {
-  c.mode = r.choice("mode", scene::CameraSpec::Mode::kAuto, kCameraModes);
+  c.mode = r.choice("mode", c.mode, kCameraModes);
   c.position = r.vec3("position", c.position);
   if (r.has("target")) c.target = r.vec3("target", c.target), c.has_target = true;
   c.azimuth_deg = r.real("azimuth", c.azimuth_deg);
@@ -95,17 +95,18 @@ void parse_light_and_ground(const Reader& r, scene::ShotSpec& shot) {
     shot.light.direction = l.vec3("direction", shot.light.direction);
     if (glm::length(shot.light.direction) == 0.0f)
       throw Error(l.key_path("direction"), "must not be [0, 0, 0]");
-    shot.light.camera_relative = !l.boolean("world", false);
+    shot.light.camera_relative = !l.boolean("world", !shot.light.camera_relative);
     shot.light.softness_deg = l.real("softness", shot.light.softness_deg);
     shot.light.turn_deg = l.real("turn", shot.light.turn_deg);
   }
   if (const toml::table* t = r.table("ground")) {
     Reader g(*t, r.key_path("ground"), "source.ground");
-    shot.ground.enabled = g.boolean("enabled", true);
-    shot.ground.size = g.real("size", 0.0f);
+    shot.ground.enabled = g.boolean("enabled", shot.ground.enabled);
+    shot.ground.size = g.real("size", shot.ground.size);
     if (g.has("height"))
       shot.ground.height = g.real("height", 0.0f), shot.ground.auto_height = false;
-    const composite::Color c = g.color("color", {0.8f, 0.8f, 0.8f});
+    const glm::vec3 d = shot.ground.color;
+    const composite::Color c = g.color("color", {d.r, d.g, d.b});
     shot.ground.color = {c.r, c.g, c.b};
   }
 }
@@ -127,9 +128,9 @@ void parse_scene_source(const Reader& r, const PathContext& ctx, pipeline::Sourc
   s.width = int(size[0]);
   s.height = int(size[1]);
   check_pixel_budget(r.key_path("size"), s.width, s.height);
-  s.shot.clip = r.string("clip", "");
-  s.shot.start_time = r.real("start", 0.0f);
-  s.shot.loop = r.boolean("loop", false);
+  s.shot.clip = r.string("clip", s.shot.clip);
+  s.shot.start_time = r.real("start", s.shot.start_time);
+  s.shot.loop = r.boolean("loop", s.shot.loop);
   s.shot.fps = s.fps;
   s.shot.first_frame = s.first_frame;
   s.shot.last_frame = s.last_frame;
@@ -234,7 +235,7 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
   const std::string raw = r.string("sequence", "");
   check_pattern(r.key_path("sequence"), raw);
   s.pattern = ctx.resolve(raw);
-  s.preset = r.choice("preset", pipeline::SourcePreset::kEmaki, kSourcePresets);
+  s.preset = r.choice("preset", s.preset, kSourcePresets);
   const bool blender = s.preset == pipeline::SourcePreset::kBlender;
   if (r.has("view_layer") && !blender)
     throw Error(r.key_path("view_layer"), "applies to preset = \"blender\" only");
@@ -243,9 +244,9 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
     if (r.has(k) && blender)
       throw Error(r.key_path(k),
                   "applies to preset = \"emaki\" only (\"blender\" knows Blender's conventions)");
-  s.world_normals = r.choice("normals", false, kNormalSpaces);
-  s.z_up = r.choice("up", false, kUpAxes);
-  s.premultiplied = r.boolean("premultiplied", false);
+  s.world_normals = r.choice("normals", s.world_normals, kNormalSpaces);
+  s.z_up = r.choice("up", s.z_up, kUpAxes);
+  s.premultiplied = r.boolean("premultiplied", s.premultiplied);
   for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera", "light",
                         "ground", "background", "size", "objects"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");

@@ -203,7 +203,7 @@ Shot parse_shot(std::string_view text, const std::string& path) {
   shot.path = path;
   const PathContext ctx{fs::path(path).parent_path()};
   const Reader top(root, "", "");
-  shot.threads = top.integer("threads", 0);
+  shot.threads = top.integer("threads", shot.threads);
   // First: the budget applies to source.size and to the sequence's first frame read below.
   if (const toml::table* t = top.table("limits")) {
     const Reader r(*t, "limits", "limits");
@@ -216,7 +216,7 @@ Shot parse_shot(std::string_view text, const std::string& path) {
   if (const toml::table* t = top.table("compositing")) {
     const Reader r(*t, "compositing", "compositing");
     shot.compositing.paper = ctx.input_file(r, "paper", false);
-    shot.compositing.paper_scale = r.real("paper_scale", 1.0f);
+    shot.compositing.paper_scale = r.real("paper_scale", shot.compositing.paper_scale);
     shot.compositing.paper_color = r.color("paper_color", shot.compositing.paper_color);
   }
   parse_outputs(Reader(*top.table("outputs", true), "outputs", "outputs"), ctx, shot.outputs);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/shot_keys.h"
 #include "shot/parser.h"
 
 namespace emaki::shot {
@@ -57,6 +58,23 @@ TEST(Schema, KeysAreUniqueAndUnderTheirTables) {
             (std::vector<std::string>{"direction", "world", "softness", "turn"}));
   EXPECT_NE(find_key("layers.NAME.guides.PASS"), nullptr);
   EXPECT_EQ(find_key("layers.NAME.wieght"), nullptr);
+}
+
+// The keys code below src/shot spells (core/shot_keys.h) are the schema's.
+TEST(Schema, KeysSpelledOutsideTheShotModuleAreInIt) {
+  using namespace shot_keys;
+  for (const std::string& key :
+       {layer("NAME"), layer_key("NAME", kSingleColour), layer_key("NAME", kTemporal),
+        layer_key("NAME", kColor), layer_key("NAME", kGradient), layer_guide("NAME", "PASS"),
+        exemplar_key("NAME", kPainting), std::string(kPaperScale), std::string(kOutputsFolder),
+        std::string(kOutputsMp4)})
+    EXPECT_NE(find_key(key), nullptr) << key;
+  for (const FieldKey& k : kFieldKeys) {
+    const std::string section = k.section;
+    const std::string key =
+        section == "exemplars" ? exemplar_key("NAME", k.key) : section + "." + k.key;
+    EXPECT_NE(find_key(key), nullptr) << k.field << " -> " << key;
+  }
 }
 
 std::string error_of(const std::string& layer_line) {

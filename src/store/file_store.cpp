@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
+#include "core/shot_keys.h"
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "store/field_file.h"
@@ -55,7 +56,7 @@ void make_folder(const fs::path& p) {
   std::error_code ec;
   fs::create_directories(p, ec);
   if (!fs::is_directory(p, ec))
-    throw Error("outputs.folder", fmt::format("cannot create folder '{}'", p.string()));
+    throw Error(shot_keys::kOutputsFolder, fmt::format("cannot create folder '{}'", p.string()));
 }
 
 bool has_ext(const std::string& name, std::size_t from, std::initializer_list<const char*> exts) {

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/shot_keys.h"
 #include "io/image_io.h"
 #include "pipeline/run.h"
 #include "store/file_store.h"
@@ -24,7 +25,7 @@ using pipeline::Shot;
 void encode_mp4(const std::string& pattern, int first, float fps, int crf, const std::string& out) {
   // Created exclusively beside the target; ffmpeg then writes the file we made (commit checks
   // that it still is).
-  TempFile tmp_file(out, "outputs.mp4");
+  TempFile tmp_file(out, shot_keys::kOutputsMp4);
   const std::string tmp = tmp_file.path();
   std::vector<std::string> args = {"ffmpeg", "-nostdin", "-y", "-loglevel", "error", "-framerate",
                                    fmt::format("{}", fps), "-start_number", std::to_string(first),
@@ -37,11 +38,11 @@ void encode_mp4(const std::string& pattern, int first, float fps, int crf, const
   argv.push_back(nullptr);
   pid_t pid = 0;
   if (posix_spawnp(&pid, "ffmpeg", nullptr, nullptr, argv.data(), environ) != 0)
-    throw Error("outputs.mp4", "cannot run 'ffmpeg' (is it installed and on PATH?)");
+    throw Error(shot_keys::kOutputsMp4, "cannot run 'ffmpeg' (is it installed and on PATH?)");
   int status = 0;
   waitpid(pid, &status, 0);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw Error("outputs.mp4", fmt::format("ffmpeg failed encoding '{}'", pattern));
+    throw Error(shot_keys::kOutputsMp4, fmt::format("ffmpeg failed encoding '{}'", pattern));
   tmp_file.commit();
 }
 

@@ -1,9 +1,7 @@
 #include "synth/patch_distance.h"
 
-#include <cstdlib>
-#include <cstring>
-
 #include "core/check.h"
+#include "core/performance.h"
 
 namespace emaki::synth {
 
@@ -52,14 +50,12 @@ bool cpu_has_avx2() {
 }
 
 PatchSsdFn best_patch_ssd() {
-  const char* force = std::getenv("EMAKI_SIMD");
-  if (force && std::strcmp(force, "scalar") == 0) return patch_ssd_scalar;
+  if (!performance().simd) return patch_ssd_scalar;
   return cpu_has_avx2() ? patch_ssd_avx2 : patch_ssd_scalar;
 }
 
 PatchSsdGroupedFn best_patch_ssd_grouped() {
-  const char* force = std::getenv("EMAKI_SIMD");
-  if (force && std::strcmp(force, "scalar") == 0) return patch_ssd_grouped_scalar;
+  if (!performance().simd) return patch_ssd_grouped_scalar;
   return cpu_has_avx2() ? patch_ssd_grouped_avx2 : patch_ssd_grouped_scalar;
 }
 

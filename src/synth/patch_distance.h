@@ -46,7 +46,8 @@ int64_t patch_ssd_grouped_avx2(const int16_t* a, std::ptrdiff_t a_stride, const 
                                const int64_t* weights, int groups);
 
 bool cpu_has_avx2();
-// The fastest kernel this CPU runs (EMAKI_SIMD=scalar in the environment forces scalar).
+// The fastest kernel this CPU runs; the scalar one when performance().simd is off
+// (core/performance.h: a front end's EMAKI_SIMD=scalar).
 PatchSsdFn best_patch_ssd();
 PatchSsdGroupedFn best_patch_ssd_grouped();
 

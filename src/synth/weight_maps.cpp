@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -14,23 +13,13 @@ namespace emaki::synth {
 
 namespace {
 
-template <typename T>
-float value_of(T v) {
-  if constexpr (std::is_same_v<T, uint8_t>)
-    return float(v) * (1.0f / 255.0f);
-  else if constexpr (std::is_same_v<T, uint16_t>)
-    return float(v) * (1.0f / 65535.0f);
-  else
-    return float(v);
-}
-
 // Calls fn(x, y, value) for the first channel of every pixel, row by row.
 template <typename Fn>
 void for_each_value(const Plane& plane, Fn&& fn) {
   std::visit(
       [&](const auto& v) {
         for (int y = 0; y < v.height; ++y)
-          for (int x = 0; x < v.width; ++x) fn(x, y, value_of(v.at(x, y)[0]));
+          for (int x = 0; x < v.width; ++x) fn(x, y, normalised(v.at(x, y)[0]));
       },
       plane);
 }

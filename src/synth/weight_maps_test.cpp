@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/performance.h"
 #include "synth/patch_distance.h"
 #include "synth/synthesizer.h"
 #include "synth/test_images.h"
@@ -154,9 +155,12 @@ TEST(WeightMaps, BitIdenticalForAnyThreadCountAndKernel) {
     const ScopedThreadCount count(threads);
     results.push_back(run(in));
   }
-  setenv("EMAKI_SIMD", "scalar", 1);
+  Performance scalar = performance();
+  scalar.simd = false;  // as EMAKI_SIMD=scalar sets it at a front end
+  set_performance(scalar);
   results.push_back(run(in));
-  unsetenv("EMAKI_SIMD");
+  scalar.simd = true;
+  set_performance(scalar);
   for (std::size_t i = 1; i < results.size(); ++i) {
     EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
     EXPECT_TRUE(same_nnf(results[0].nnf, results[i].nnf)) << "run " << i;
