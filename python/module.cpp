@@ -2,6 +2,7 @@
 // renderer and the reference sphere. Everything runs the same C++ code as the command line.
 #include <pybind11/pybind11.h>
 
+#include "core/version.h"
 #include "python/bindings.h"
 #include "python/errors.h"
 
@@ -16,7 +17,7 @@ PYBIND11_MODULE(emaki, m) {
       "template()  the reference sphere's passes and paint template (as `emaki template`)\n"
       "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
       "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = emaki::version();
   // Each docstring starts with its own signature (Python types, as in emaki.pyi) instead of
   // pybind11's, which would show C++ handle types.
   py::options options;
