@@ -75,7 +75,7 @@ constexpr KeySpec kSchema[] = {
     {.key = "exemplars.NAME.kind", .type = "string", .default_value = "`\"matcap\"`", .meaning = "`matcap`: a painted sphere, its guides are the reference sphere's passes fitted to it (as `emaki template --fit`); `keyframe`: a painted frame with its pass file"},
     {.key = "exemplars.NAME.painting", .type = "string (path)", .default_value = "required", .meaning = "the painting (PNG/EXR/TIFF/JPEG; grey, RGB or RGBA)"},
     {.key = "exemplars.NAME.sphere", .type = "[cx, cy, r]", .default_value = "image centre, 30 % of height", .range = "r > 0", .meaning = "matcap: the painted sphere's centre and radius in pixels (x right, y down)"},
-    {.key = "exemplars.NAME.elevation", .type = "number", .default_value = "`15`", .lo = -80, .hi = 80, .meaning = "matcap: camera degrees above the horizon"},
+    {.key = "exemplars.NAME.elevation", .type = "number", .default_value = "`10`", .lo = -80, .hi = 80, .meaning = "matcap: camera degrees above the horizon"},
     {.key = "exemplars.NAME.horizon", .type = "number", .default_value = "—", .meaning = "matcap: image row of the ground's horizon (sets the elevation instead)"},
     {.key = "exemplars.NAME.fov", .type = "number", .default_value = "`30`", .lo = 1, .hi = 120, .meaning = "matcap: vertical field of view, degrees"},
     {.key = "exemplars.NAME.light", .type = "[x, y, z]", .default_value = "`[-1, 1, 1]`", .meaning = "matcap: towards the key light, camera-relative; use the shot's light direction"},

@@ -674,6 +674,8 @@ def parse_args(argv):
     p.add_argument("--reference", action="store_true",
                    help="render the reference sphere instead of the open scene")
     p.add_argument("--sphere", help="reference: CX,CY,R pixels (default: centred, 30%% of h)")
+    # emaki's one default for the reference camera (exemplar::kDefaultReferenceElevationDeg;
+    # python/tests/test_defaults.py checks that they agree).
     p.add_argument("--elevation", type=float, default=10.0, help="reference: degrees (10)")
     p.add_argument("--fov", type=float, help="vertical field of view, degrees (reference: 30, "
                    "--look-from: 40)")
