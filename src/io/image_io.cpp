@@ -95,8 +95,10 @@ const OiioBackend& oiio_backend(const std::string& subject) {
   std::call_once(once, [] {
     std::vector<std::string> candidates;
     if (const char* env = std::getenv("EMAKI_OIIO_MODULE")) candidates.push_back(env);
-    // Beside the executable (installed layouts) or the shared object holding this code (the
-    // Python module), then where the build put it.
+    // Beside the executable or at PREFIX/lib/emaki from PREFIX/bin/emaki (the installed
+    // layout, cmake/install.cmake); beside the shared object holding this code or at
+    // PREFIX/lib/emaki from the Python module in PREFIX/lib/python3/dist-packages; then where
+    // the build put it.
     std::error_code ec;
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (!ec) {
@@ -104,9 +106,11 @@ const OiioBackend& oiio_backend(const std::string& subject) {
       candidates.push_back((exe.parent_path() / "../lib/emaki/libemaki_io_oiio.so").string());
     }
     Dl_info self{};
-    if (dladdr(reinterpret_cast<void*>(&oiio_backend), &self) != 0 && self.dli_fname)
-      candidates.push_back(
-          (fs::path(self.dli_fname).parent_path() / "libemaki_io_oiio.so").string());
+    if (dladdr(reinterpret_cast<void*>(&oiio_backend), &self) != 0 && self.dli_fname) {
+      const fs::path here = fs::path(self.dli_fname).parent_path();
+      candidates.push_back((here / "libemaki_io_oiio.so").string());
+      candidates.push_back((here / "../../emaki/libemaki_io_oiio.so").string());
+    }
 #ifdef EMAKI_OIIO_MODULE_PATH
     candidates.push_back(EMAKI_OIIO_MODULE_PATH);
 #endif
