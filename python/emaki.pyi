@@ -51,7 +51,7 @@ def synthesize(
     nnf: Literal[False] = False,
     error: Literal[False] = False,
     dtype: Optional[DType] = None,
-    progress: Optional[Callable[[int, int], None]] = None,
+    progress: Optional[Callable[[dict], object]] = None,
 ) -> Array: ...
 @overload
 def synthesize(
@@ -72,7 +72,7 @@ def synthesize(
     nnf: bool = False,
     error: bool = False,
     dtype: Optional[DType] = None,
-    progress: Optional[Callable[[int, int], None]] = None,
+    progress: Optional[Callable[[dict], object]] = None,
 ) -> Union[Array, Tuple[Array, ...]]: ...
 def read_image(path: PathLike, channels: Optional[Sequence[str]] = None) -> Array: ...
 def write_image(
