@@ -62,11 +62,10 @@ install(FILES ${EMAKI_ADDON_ZIP} DESTINATION share/emaki/blender COMPONENT runti
 install(PROGRAMS tools/hatching/make_hatching.py DESTINATION share/emaki/tools COMPONENT runtime)
 
 # ---- dev: find_package(emaki CONFIG) ----------------------------------------------------------
-# The module libraries as emaki::NAME (emaki_module's EXPORT_NAME). Static, so the export
-# carries their private dependencies as link-only: emakiConfig.cmake finds them.
-set(EMAKI_EXPORTED emaki_core emaki_version emaki_synth emaki_scene emaki_io emaki_render
-                   emaki_exemplar emaki_composite emaki_temporal emaki_pipeline emaki_store
-                   emaki_shot)
+# Every module library (each emaki_module) as emaki::NAME, so a new module is exported with
+# the others. Static, so the export carries their private dependencies as link-only:
+# emakiConfig.cmake finds them.
+get_property(EMAKI_EXPORTED GLOBAL PROPERTY EMAKI_MODULES)
 install(TARGETS ${EMAKI_EXPORTED} EXPORT emakiTargets
         ARCHIVE DESTINATION lib COMPONENT dev)
 install(DIRECTORY src/ DESTINATION include/emaki COMPONENT dev
