@@ -3,7 +3,8 @@
 # build/release (./scripts/build.sh):
 #  1. `cmake --install` into a prefix, then moved (the tree is relocatable): `emaki --version`,
 #     the man page, the Python module by PYTHONPATH, the OpenImageIO plugin found from the binary
-#     and from the module, and a C++ project built with find_package(emaki) against the tree;
+#     and from the module (and one line naming a library it needs that is missing), and a C++
+#     project built with find_package(emaki) against the tree;
 #  2. cpack's emaki_<version>_amd64.deb (runtime dependencies only) installed with apt-get; from
 #     a folder outside the checkout: `emaki run` on the installed example (two frames, small
 #     size), `import emaki` with /usr/bin/python3 and no PYTHONPATH; `apt-get remove` then
@@ -58,6 +59,22 @@ case "$plugin" in
   *) fail "the Python module loaded '$plugin'" ;;
 esac
 step "the binary and the Python module load the prefix's OpenImageIO plugin"
+# A library the plugin needs is missing: one line naming it, exit 1, no output file.
+mv "$P/lib/emaki/libemaki_io_oiio.so" "$WORK/plugin.so"
+printf 'int emaki_gone(void) { return 1; }\n' >"$WORK/gone.c"
+printf 'int emaki_gone(void);\nint emaki_oiio_backend(void) { return emaki_gone(); }\n' \
+  >"$WORK/plugin.c"
+cc -shared -fPIC -o "$WORK/libemaki_gone.so" "$WORK/gone.c"
+cc -shared -fPIC -o "$P/lib/emaki/libemaki_io_oiio.so" "$WORK/plugin.c" -L"$WORK" -lemaki_gone
+rm "$WORK/libemaki_gone.so"
+if "$P/bin/emaki" template --size 32x24 --aa 1 --out "$WORK/broken" 2>"$WORK/err"; then
+  fail "emaki ran with a plugin whose library is missing"
+fi
+[ "$(wc -l <"$WORK/err")" -eq 1 ] && grep -q "libemaki_gone.so: cannot open" "$WORK/err" ||
+  fail "not one line naming the missing library: $(cat "$WORK/err")"
+[ ! -e "$WORK/broken/reference.exr" ] || fail "output written without the plugin"
+mv "$WORK/plugin.so" "$P/lib/emaki/libemaki_io_oiio.so"
+step "a library missing under the plugin: $(cat "$WORK/err")"
 cmake -S "$ROOT/tests/install_consumer" -B "$WORK/consumer" -DCMAKE_PREFIX_PATH="$P" \
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null
 cmake --build "$WORK/consumer" >/dev/null
