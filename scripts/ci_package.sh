@@ -18,7 +18,7 @@ SUDO=""
 WORK=$(mktemp -d /tmp/emaki_package.XXXXXX)
 installed=""
 cleanup() {
-  [ -n "$installed" ] && $SUDO apt-get remove -y -qq emaki >/dev/null 2>&1
+  [ -n "$installed" ] && $SUDO apt-get purge -y -qq emaki >/dev/null 2>&1
   rm -rf "$WORK"
 }
 trap cleanup EXIT
@@ -34,6 +34,9 @@ plugin_loaded() {
 }
 
 # ---- 1. a prefix ------------------------------------------------------------------------------
+# Up to date first (nothing to do after ./run_tests.sh): cpack builds `all` before packing, and the
+# prefix and the package must hold the same build.
+cmake --build "$B" -j"$(nproc)" >/dev/null
 # Over an older install: a module built for another Python does not stay beside the new one.
 stale=$WORK/installed/lib/python3/dist-packages/emaki.cpython-39-x86_64-linux-gnu.so
 mkdir -p "$(dirname "$stale")"
@@ -112,4 +115,6 @@ installed=""
 left=$(ls -d /usr/bin/emaki /usr/lib/emaki /usr/share/emaki /usr/share/man/man1/emaki.1* \
   /usr/lib/python3/dist-packages/emaki* 2>/dev/null || true)
 [ -z "$left" ] || fail "left after apt-get remove: $left"
+# dpkg keeps a removed package's record ("rc") until purged: none is left of this one either.
+$SUDO dpkg --purge emaki >/dev/null
 step "apt-get remove emaki: nothing left"
