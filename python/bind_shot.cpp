@@ -4,8 +4,10 @@
 #include <pybind11/eval.h>
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,8 +34,8 @@ class PyShot {
  public:
   explicit PyShot(pipeline::Shot shot) : shot_(std::move(shot)) {}
 
-  static PyShot load(const std::string& path) {
-    return PyShot(translating(ErrorKind::kFile, {}, [&] { return shot::open(path); }));
+  static PyShot load(const std::filesystem::path& path) {
+    return PyShot(translating(ErrorKind::kFile, {}, [&] { return shot::open(path.string()); }));
   }
   static PyShot from_toml(const std::string& text, const std::string& path) {
     return PyShot(translating(ErrorKind::kInput, {}, [&] { return shot::open_text(text, path); }));
@@ -45,8 +47,7 @@ class PyShot {
                const py::object& threads, const py::object& progress,
                const py::object& max_memory_mb) {
     shot::Request r = request(frames, threads, max_memory_mb);
-    r.layers =
-        layers.is_none() ? std::vector<std::string>{} : layers.cast<std::vector<std::string>>();
+    r.layers = layer_names(layers);
     r.force = force;
     r.previews = previews;
     PendingError pending;
@@ -83,7 +84,8 @@ class PyShot {
     out["reused"] = res->report.reused;
     out["composited"] = res->report.composited;
     out["frames"] = py::make_tuple(res->report.first_frame, res->report.last_frame);
-    out["previews"] = res->previews;
+    out["previews"] =
+        std::vector<std::filesystem::path>(res->previews.begin(), res->previews.end());
     return out;
   }
 
@@ -122,23 +124,46 @@ class PyShot {
   }
 
  private:
+  // `value` as T, or emaki.InputError naming `argument` and what it expected (never pybind11's
+  // "Unable to cast" RuntimeError). A bool is not taken for a number, nor a str for a list.
+  template <typename T>
+  static T cast_argument(const py::object& value, const char* argument, const char* expected) {
+    const bool refused = py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value);
+    if (!refused) {
+      try {
+        return value.cast<T>();
+      } catch (const py::cast_error&) {
+      }
+    }
+    raise_input_error(argument, fmt::format("expected {}, got {} {}", expected,
+                                            std::string(py::str(value.get_type().attr("__name__"))),
+                                            std::string(py::repr(value))));
+  }
+
+  static std::vector<std::string> layer_names(const py::object& layers) {
+    if (layers.is_none()) return {};
+    return cast_argument<std::vector<std::string>>(layers, "layers",
+                                                   "a list of layer names (layers=['base'])");
+  }
+
   shot::Request request(const py::object& frames, const py::object& threads,
                         const py::object& max_memory_mb = py::none()) const {
     shot::Request r;
-    if (py::isinstance<py::int_>(frames)) {
+    constexpr const char* kFrames = "a frame or (first, last), e.g. frames=(0, 3)";
+    if (py::isinstance<py::int_>(frames) && !py::isinstance<py::bool_>(frames)) {
       r.first_frame = r.last_frame = frames.cast<int>();
     } else if (!frames.is_none()) {
-      const auto ab = frames.cast<std::vector<int>>();
+      const auto ab = cast_argument<std::vector<int>>(frames, "frames", kFrames);
       if (ab.size() != 2) raise_input_error("frames", "expected a frame or (first, last)");
       r.first_frame = ab[0], r.last_frame = ab[1];
     }
     if (r.first_frame < -1 || r.last_frame < -1) raise_input_error("frames", "frames must be >= 0");
     if (!threads.is_none()) {
-      r.threads = threads.cast<int>();
+      r.threads = cast_argument<int>(threads, "threads", "an int or None");
       if (r.threads < 0 || r.threads > 1024) raise_input_error("threads", "must be in [0, 1024]");
     }
     if (!max_memory_mb.is_none()) {
-      r.max_memory_mb = max_memory_mb.cast<int64_t>();
+      r.max_memory_mb = cast_argument<int64_t>(max_memory_mb, "max_memory_mb", "an int or None");
       if (r.max_memory_mb < 1 || r.max_memory_mb > (int64_t(1) << 40))
         raise_input_error("max_memory_mb", "must be in [1, 2**40] (MB) or None");
     }
@@ -164,6 +189,7 @@ argument ("frames", "layers", "layer"); emaki.FileError for a file that cannot b
 // parser (so a bad key is named by its key path exactly as in a file).
 constexpr const char* kFromDict = R"(
 import json as _json
+import os as _os
 import re as _re
 
 
@@ -203,7 +229,7 @@ def _toml_table(d, prefix, lines):
 
 
 def from_dict(d, path="shot.toml"):
-    """from_dict(d: dict, path: str = "shot.toml") -> Shot
+    """from_dict(d: dict, path: str | os.PathLike = "shot.toml") -> Shot
 
     A shot from nested dicts with the shot file's keys (docs/shot_file.md), e.g.
     {"source": {"scene": "Fox.glb", "frames": [0, 47], "size": [960, 540]}, ...}. Relative
@@ -213,17 +239,31 @@ def from_dict(d, path="shot.toml"):
         raise TypeError("from_dict expects a dict")
     lines = []
     _toml_table(d, "", lines)
-    return Shot._from_toml("\n".join(lines) + "\n", path)
+    return Shot._from_toml("\n".join(lines) + "\n", _os.fspath(path))
 )";
 
 }  // namespace
 
 void bind_shot(py::module_& m) {
   py::class_<PyShot>(m, "Shot", kShotDoc)
+      .def(py::init(&PyShot::load), py::arg("path"),
+           "Shot(path: str | os.PathLike) -> Shot\n\nThe same as Shot.load(path).")
       .def_static("load", &PyShot::load, py::arg("path"),
-                  "load(path: str) -> Shot\n\nReads and checks a shot file; writes nothing.")
+                  "load(path: str | os.PathLike) -> Shot\n\nReads and checks a shot file; "
+                  "writes nothing.")
+      .def("__repr__",
+           [](const PyShot& s) {
+             const pipeline::Shot& shot = s.shot();
+             std::string layers;
+             for (const auto& l : shot.layers) layers += (layers.empty() ? "" : ", ") + l.name;
+             return fmt::format("<emaki.Shot {} frames {}-{} {}x{} layers [{}]>",
+                                std::string(py::repr(py::str(shot.path))), shot.source.first_frame,
+                                shot.source.last_frame, shot.source.width, shot.source.height,
+                                layers);
+           })
       .def_static("_from_toml", &PyShot::from_toml, py::arg("text"), py::arg("path"))
-      .def_property_readonly("path", [](const PyShot& s) { return s.shot().path; })
+      .def_property_readonly("path",
+                             [](const PyShot& s) { return std::filesystem::path(s.shot().path); })
       .def_property_readonly("frames",
                              [](const PyShot& s) {
                                return py::make_tuple(s.shot().source.first_frame,
@@ -239,8 +279,9 @@ void bind_shot(py::module_& m) {
                                for (const auto& l : s.shot().layers) names.push_back(l.name);
                                return names;
                              })
-      .def_property_readonly("output_folder",
-                             [](const PyShot& s) { return s.shot().outputs.folder; })
+      .def_property_readonly(
+          "output_folder",
+          [](const PyShot& s) { return std::filesystem::path(s.shot().outputs.folder); })
       .def("run", &PyShot::run, py::kw_only(), py::arg("frames") = py::none(),
            py::arg("layers") = py::none(), py::arg("force") = false, py::arg("previews") = true,
            py::arg("threads") = py::none(), py::arg("progress") = py::none(),
@@ -257,7 +298,8 @@ void bind_shot(py::module_& m) {
            "max_memory_mb: refuse to start when the estimated peak memory exceeds it (what the "
            "machine has available is always checked).\n"
            "The GIL is released while it runs; Ctrl-C stops it after the current layer-frame.\n"
-           "Returns {synthesized, reused, composited, frames, previews}.")
+           "Returns {synthesized, reused, composited, frames, previews (a list of "
+           "pathlib.Path)}.")
       .def("composite", &PyShot::composite, py::kw_only(), py::arg("frames") = py::none(),
            py::arg("previews") = true, py::arg("threads") = py::none(),
            py::arg("max_memory_mb") = py::none(),

@@ -61,8 +61,9 @@ Args:
     error: also return the per-pixel patch error, float32 HxW (EbSynth units). Default False.
     dtype: the result's dtype, uint8, uint16 or float32 (integers: clamped to [0, 1] and
         rounded, as `emaki synth` writes PNG files); None (default): the style's dtype.
-    progress: optional callable(level, levels), called with the GIL held as each pyramid
-        level starts; an exception it raises stops the synthesis and propagates.
+    progress: optional callable(p), called with the GIL held as each pyramid level starts,
+        p = {'level': 0.., 'levels': n} (one dict, as Shot.run's progress gets); an exception
+        it raises stops the synthesis and propagates.
 
 Returns:
     B', HxWxC (HxW for an HxW style without a mask): the style's channels that count, given
@@ -167,7 +168,10 @@ synth::Result run_engine(const ArrayPlane& style, const std::vector<GuideArrays>
   if (!progress.is_none())
     params.progress = [&pending, &progress](int level, int levels) {
       py::gil_scoped_acquire gil;
-      PyObject* returned = PyObject_CallFunction(progress.ptr(), "ii", level, levels);
+      py::dict p;
+      p["level"] = level;
+      p["levels"] = levels;
+      PyObject* returned = PyObject_CallFunctionObjArgs(progress.ptr(), p.ptr(), nullptr);
       if (returned == nullptr) {
         pending.fetch();
         throw synth::Cancelled();
@@ -227,7 +231,7 @@ py::object synthesize(const py::handle& style_obj, const py::sequence& guides_ob
   params.seed = checked_seed(seed);
   checked_int(threads, "threads", 0, synth::kMaxThreads);
   if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
-    raise_input_error("progress", "must be callable(level, levels) or None");
+    raise_input_error("progress", "must be callable({'level', 'levels'}) or None");
 
   ArrayPlane style = inspect_array(style_obj, "style");
   std::vector<GuideArrays> guides = guide_arrays(guides_obj);

@@ -4,6 +4,7 @@ The docstrings (help(emaki.synthesize), ...) give each argument's range and defa
 """
 
 import os
+import pathlib
 from typing import Callable, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
@@ -50,7 +51,7 @@ def synthesize(
     nnf: Literal[False] = False,
     error: Literal[False] = False,
     dtype: Optional[DType] = None,
-    progress: Optional[Callable[[int, int], None]] = None,
+    progress: Optional[Callable[[dict], object]] = None,
 ) -> Array: ...
 @overload
 def synthesize(
@@ -71,7 +72,7 @@ def synthesize(
     nnf: bool = False,
     error: bool = False,
     dtype: Optional[DType] = None,
-    progress: Optional[Callable[[int, int], None]] = None,
+    progress: Optional[Callable[[dict], object]] = None,
 ) -> Union[Array, Tuple[Array, ...]]: ...
 def read_image(path: PathLike, channels: Optional[Sequence[str]] = None) -> Array: ...
 def write_image(
@@ -125,12 +126,13 @@ def template(
 
 class Shot:
     """A shot file's settings, checked (docs/shot_file.md); the shot API of `emaki run`."""
+    def __init__(self, path: PathLike) -> None: ...  # the same as Shot.load(path)
     @staticmethod
-    def load(path: str) -> "Shot": ...
+    def load(path: PathLike) -> "Shot": ...
     @staticmethod
-    def from_dict(d: Mapping[str, object], path: str = "shot.toml") -> "Shot": ...
+    def from_dict(d: Mapping[str, object], path: PathLike = "shot.toml") -> "Shot": ...
     @property
-    def path(self) -> str: ...
+    def path(self) -> pathlib.Path: ...
     @property
     def frames(self) -> Tuple[int, int]: ...
     @property
@@ -138,7 +140,7 @@ class Shot:
     @property
     def layers(self) -> list[str]: ...
     @property
-    def output_folder(self) -> str: ...
+    def output_folder(self) -> pathlib.Path: ...
     def run(
         self,
         *,

@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include "core/performance.h"
+#include "core/version.h"
 #include "python/bindings.h"
 #include "python/errors.h"
 
@@ -17,7 +18,7 @@ PYBIND11_MODULE(emaki, m) {
       "template()  the reference sphere's passes and paint template (as `emaki template`)\n"
       "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
       "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = emaki::version();
   // The one performance switch (core/performance.h), as the command line applies it: huge-page
   // advice on large images, SIMD kernels unless EMAKI_SIMD=scalar.
   emaki::set_performance(emaki::performance_from_environment());

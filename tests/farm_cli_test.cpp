@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "core/version.h"
 #include "tests/cli_run.h"
 #include "tests/small_painting.h"
 
@@ -147,6 +148,14 @@ TEST_F(FarmCli, AShotFileNamedLikeAnOptionIsAFile) {
 TEST_F(FarmCli, PreviewsOfAnUnpreparedFolderAreAnError) {
   const fs::path a = write_shot("a.toml", (dir_ / "out").string());
   expect_error(emaki({"task", "previews", a.string()}), (dir_ / "out").string());
+}
+
+// A task's log (its stdout and stderr, docs/farm.md) starts with the version that ran it.
+TEST_F(FarmCli, ATaskLogStartsWithTheVersion) {
+  const fs::path a = write_shot("a.toml", (dir_ / "out").string());
+  const test::CliResult r = emaki({"task", "prepare", a.string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, std::string("emaki task: emaki ") + version() + "\n");
 }
 
 }  // namespace

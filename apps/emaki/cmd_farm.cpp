@@ -18,6 +18,7 @@
 #include "apps/emaki/shot_command.h"
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/version.h"
 #include "farm/slurm.h"
 #include "shot/api.h"
 #include "shot/plan.h"
@@ -155,6 +156,15 @@ int run_plan(const Args& args) {
 
 int run_farm(const Args& args) {
   const std::string usage = "usage: emaki farm submit|status|cancel SHOT... (see --help of each)";
+  if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
+    std::printf(
+        "Runs shots on a Slurm farm.\n%s\n\n"
+        "  submit  the shots' unfinished tasks as job arrays (sbatch)\n"
+        "  status  each task: pending, running, done, failed (with its log and error line)\n"
+        "  cancel  the shots' queued and running jobs (scancel)\n",
+        usage.c_str());
+    return 0;
+  }
   if (args.empty()) throw Error("", usage);
   const Args rest(args.begin() + 1, args.end());
   if (args[0] == "submit") return farm_submit(rest);
@@ -168,6 +178,17 @@ int run_task(const Args& args) {
       "usage: emaki task prepare|passes|layer|composite|previews SHOT [--frames A-B] "
       "[--layer NAME] (one task of `emaki plan`)";
   const std::vector<std::string> kinds = {"prepare", "passes", "layer", "composite", "previews"};
+  if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
+    std::printf(
+        "One task of a shot's plan, as a farm node runs it.\n%s\n\n"
+        "  prepare    the output folders and their settings, before the other tasks\n"
+        "  passes     the guide passes of a chunk of frames\n"
+        "  layer      a layer's frames: a chunk, or the whole range of a temporal layer\n"
+        "  composite  the composited frames of a chunk\n"
+        "  previews   the contact sheet and the MP4\n",
+        usage.c_str());
+    return 0;
+  }
   if (args.empty() || std::find(kinds.begin(), kinds.end(), args[0]) == kinds.end())
     throw Error("", usage);
   const std::string kind = args[0];
@@ -180,6 +201,10 @@ int run_task(const Args& args) {
   c.bind(app, "FIRST-LAST or FRAME");
   if (kind == "layer") app.add_option("--layer", layer, "the layer")->required();
   if (parse_cli(app, Args(args.begin() + 1, args.end()))) return 0;
+  // A task's log (its stdout and stderr) starts with the emaki that ran it: which version made
+  // a frame on the farm. On stdout, so that an error stays stderr's one line.
+  std::printf("emaki task: emaki %s\n", version());
+  std::fflush(stdout);
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request r = c.request("task");
   r.farm_task = true;

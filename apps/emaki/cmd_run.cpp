@@ -170,6 +170,15 @@ int run_qa_ghost(const Args& args) {
 
 int run_qa(const Args& args) {
   const std::string usage = "usage: emaki qa flicker|ghost SHOT --layer NAME [--frames A-B]";
+  if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
+    std::printf(
+        "Quality checks of a finished layer.\n%s\n\n"
+        "  flicker  temporal error along the motion vectors, per object and ground\n"
+        "  ghost    what a temporal layer carried over from another object where a surface "
+        "appears\n",
+        usage.c_str());
+    return 0;
+  }
   if (args.empty() || (args[0] != "flicker" && args[0] != "ghost")) throw Error("", usage);
   const Args rest(args.begin() + 1, args.end());
   return args[0] == "flicker" ? run_qa_flicker(rest) : run_qa_ghost(rest);

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/performance.h"
+#include "core/version.h"
 
 namespace emaki::app {
 
@@ -27,8 +28,17 @@ const std::vector<Command>& commands() {
       {"plan", "shots as a task graph for a render farm (a table, or --json)", run_plan},
       {"farm", "run shots on Slurm: 'emaki farm submit|status|cancel SHOT...'", run_farm},
       {"task", "one task of a plan, as a farm node runs it", run_task},
+      {"version", "the version: the release, and the git revision when built from a checkout",
+       run_version},
   };
   return list;
+}
+
+int run_version(const Args& args) {
+  if (!args.empty() && args[0] != "--help" && args[0] != "-h")
+    throw Error("", "usage: emaki version (or emaki --version)");
+  std::printf("emaki %s\n", emaki::version());
+  return 0;
 }
 
 namespace {
@@ -63,7 +73,8 @@ void print_usage() {
   for (const auto& c : commands()) std::printf("  %-10s %s\n", c.name, c.summary);
   std::printf(
       "\n'emaki <command> --help' documents a command's options. Every command also takes\n"
-      "--max-pixels N: the largest image, in pixels, read or made (default 2^28).\n");
+      "--max-pixels N: the largest image, in pixels, read or made (default 2^28).\n"
+      "'emaki --version' prints the version.\n");
 }
 }  // namespace
 }  // namespace emaki::app
@@ -80,6 +91,7 @@ int main(int argc, char** argv) {
     print_usage();
     return argc < 2 ? 2 : 0;
   }
+  if (std::string(argv[1]) == "--version") return run_version({});
   const std::string name = argv[1];
   // `--max-pixels N` is global: the pixel budget every image read or allocated is checked
   // against before allocation (default 2^28). It may stand anywhere after the command.

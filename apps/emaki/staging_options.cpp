@@ -35,7 +35,7 @@ struct SubjectTraits {
 constexpr SubjectTraits kSceneTraits{
     .size = "640x360",
     .aa = 2,
-    .elevation = 15.0f,
+    .elevation = scene::kDefaultAutoElevationDeg,
     .max_elevation = 89.0f,
     .fov = 40.0f,
     .max_fov = 170.0f,
@@ -55,7 +55,7 @@ constexpr SubjectTraits kSceneTraits{
 constexpr SubjectTraits kReferenceSphereTraits{
     .size = "1024x768",
     .aa = 3,
-    .elevation = 10.0f,
+    .elevation = exemplar::kDefaultReferenceElevationDeg,
     .max_elevation = 80.0f,
     .fov = 30.0f,
     .max_fov = 120.0f,

@@ -15,6 +15,6 @@ E = "examples/stylit/"
 style = emaki.read_image(E + "source_style.png")  # HxWx3 uint8, read in place by the engine
 guides = [(emaki.read_image(E + "source_%s.png" % g), emaki.read_image(E + "target_%s.png" % g), 0.5)
           for g in ("fullgi", "dirdif", "dirspc", "indirb")]
-out = emaki.synthesize(style, guides, seed=1, progress=lambda l, n: print("level %d/%d" % (l + 1, n)))
+out = emaki.synthesize(style, guides, seed=1, progress=lambda p: print("level %d/%d" % (p["level"] + 1, p["levels"])))
 emaki.write_image(sys.argv[1] if len(sys.argv) > 1 else "stylit.png", out)  # uint8 -> 8-bit PNG
 print("wrote", sys.argv[1] if len(sys.argv) > 1 else "stylit.png", out.shape, out.dtype)

@@ -113,6 +113,30 @@ def test_errors_name_the_key_or_the_argument(tmp_path):
     assert not (tmp_path / "out").exists()  # refused before anything was written
 
 
+@pytest.mark.parametrize("kwargs, subject", [
+    (dict(layers="base"), "layers"), (dict(layers=[1]), "layers"), (dict(frames="0-3"), "frames"),
+    (dict(frames=True), "frames"), (dict(threads="2"), "threads"),
+    (dict(max_memory_mb="8G"), "max_memory_mb")])
+def test_wrong_argument_types_are_input_errors_naming_the_argument(tmp_path, kwargs, subject):
+    shot = emaki.Shot.from_dict(tiny(tmp_path / "out"))
+    with pytest.raises(emaki.InputError) as e:
+        shot.run(**kwargs)
+    assert e.value.subject == subject and "expected" in str(e.value)
+    assert not (tmp_path / "out").exists()
+
+
+def test_paths_are_pathlib_both_ways(tmp_path):
+    shot_file = tmp_path / "tiny.toml"
+    shot_file.write_text("\n".join(toml_text(tiny(tmp_path / "out"))) + "\n")
+    for shot in (emaki.Shot.load(shot_file), emaki.Shot(shot_file),
+                 emaki.Shot.from_dict(tiny(tmp_path / "out"), tmp_path / "d.toml")):
+        assert isinstance(shot.path, pathlib.Path) and shot.output_folder == tmp_path / "out"
+        assert repr(shot).startswith("<emaki.Shot '") and "layers [base, ink]" in repr(shot)
+    assert emaki.Shot(shot_file).path == shot_file
+    report = emaki.Shot(shot_file).run(threads=1)
+    assert report["previews"] and all(isinstance(p, pathlib.Path) for p in report["previews"])
+
+
 def test_a_raising_progress_callback_stops_the_run(tmp_path):
     shot = emaki.Shot.from_dict(tiny(tmp_path / "out"))
 

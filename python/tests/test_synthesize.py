@@ -88,19 +88,19 @@ def test_seed_and_schedule_options_change_the_result():
 def test_progress_is_called_per_level_and_its_exception_propagates():
     style, src, tgt = noise((64, 64, 3), 1), noise((64, 64, 3), 2), noise((64, 64, 3), 3)
     calls = []
-    emaki.synthesize(style, [(src, tgt)], progress=lambda level, levels: calls.append((level, levels)))
+    emaki.synthesize(style, [(src, tgt)], progress=lambda p: calls.append((p["level"], p["levels"])))
     assert calls and calls[0][0] == 0 and all(n == calls[0][1] for _, n in calls)
     assert [l for l, _ in calls] == list(range(calls[0][1]))
     returned = object()
     count = sys.getrefcount(returned)
-    emaki.synthesize(style, [(src, tgt)], progress=lambda level, levels: returned)
+    emaki.synthesize(style, [(src, tgt)], progress=lambda p: returned)
     assert sys.getrefcount(returned) == count  # what progress returns is not kept
 
     class Stop(Exception):
         pass
 
-    def stop(level, levels):
-        if level == 1:
+    def stop(p):
+        if p["level"] == 1:
             raise Stop("from progress")
 
     with pytest.raises(Stop):

@@ -15,15 +15,21 @@
 
 namespace emaki::exemplar {
 
+// The reference camera's default elevation, degrees above the horizon: the one default of
+// `emaki template --elevation`, emaki.template(elevation=), a shot's exemplars.NAME.elevation
+// and the Blender exporter's --reference --elevation. python/tests/test_defaults.py checks that
+// every front end (and the docs) shows this value.
+inline constexpr float kDefaultReferenceElevationDeg = 10.0f;
+
 struct ReferenceSpec {
   int width = 1024;                // pixels
   int height = 768;                // pixels
   glm::vec2 center{-1.0f, -1.0f};  // sphere centre in pixels (x right, y down); <0: image centre
   float radius = 0.0f;             // sphere radius in pixels; 0: 30 % of the height
-  float elevation_deg = 10.0f;     // camera above the horizon, [-80, 80]
-  float horizon_row = NAN;         // if set: elevation chosen so the horizon sits on this row
-  float fov_deg = 30.0f;           // vertical field of view, [1, 120]
-  scene::LightSpec light;          // camera-relative by default, as in a shot
+  float elevation_deg = kDefaultReferenceElevationDeg;  // above the horizon, [-80, 80]
+  float horizon_row = NAN;  // if set: elevation chosen so the horizon sits on this row
+  float fov_deg = 30.0f;    // vertical field of view, [1, 120]
+  scene::LightSpec light;   // camera-relative by default, as in a shot
   bool ground = true;
   glm::vec3 ground_color{0.8f};
   glm::vec3 background{0.0f};

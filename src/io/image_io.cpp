@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 #include <fmt/format.h>
+#include <link.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -95,27 +96,37 @@ const OiioBackend& oiio_backend(const std::string& subject) {
   std::call_once(once, [] {
     std::vector<std::string> candidates;
     if (const char* env = std::getenv("EMAKI_OIIO_MODULE")) candidates.push_back(env);
-    // Beside the executable (installed layouts) or the shared object holding this code (the
-    // Python module), then where the build put it.
+    // Relative to what holds this code (the installed layout, cmake/install.cmake): linked
+    // into an executable, beside it or at PREFIX/lib/emaki from PREFIX/bin/emaki; in a shared
+    // object (the Python module), beside it or at PREFIX/lib/emaki from
+    // PREFIX/lib/python3/dist-packages, never relative to the python3 running it. Then where
+    // the build put it.
     std::error_code ec;
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec) {
+    Dl_info self{};
+    link_map* object = nullptr;
+    const bool in_shared_object =
+        dladdr1(reinterpret_cast<void*>(&oiio_backend), &self, reinterpret_cast<void**>(&object),
+                RTLD_DL_LINKMAP) != 0 &&
+        object && object->l_name && object->l_name[0] != '\0' && self.dli_fname;
+    if (in_shared_object) {
+      const fs::path here = fs::path(self.dli_fname).parent_path();
+      candidates.push_back((here / "libemaki_io_oiio.so").string());
+      candidates.push_back((here / "../../emaki/libemaki_io_oiio.so").string());
+    } else if (const fs::path exe = fs::read_symlink("/proc/self/exe", ec); !ec) {
       candidates.push_back((exe.parent_path() / "libemaki_io_oiio.so").string());
       candidates.push_back((exe.parent_path() / "../lib/emaki/libemaki_io_oiio.so").string());
     }
-    Dl_info self{};
-    if (dladdr(reinterpret_cast<void*>(&oiio_backend), &self) != 0 && self.dli_fname)
-      candidates.push_back(
-          (fs::path(self.dli_fname).parent_path() / "libemaki_io_oiio.so").string());
 #ifdef EMAKI_OIIO_MODULE_PATH
     candidates.push_back(EMAKI_OIIO_MODULE_PATH);
 #endif
+    // The first that exists is the plugin: if it cannot load (a library it needs is missing),
+    // that is the error, naming the library, rather than a fall back to another build's plugin.
     for (const auto& c : candidates) {
       if (!fs::exists(c, ec)) continue;
       void* h = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);
       if (!h) {
         failure = dlerror();
-        continue;
+        return;
       }
       using Fn = const OiioBackend* (*)();
       if (auto fn = reinterpret_cast<Fn>(dlsym(h, "emaki_oiio_backend"))) {
@@ -125,8 +136,10 @@ const OiioBackend& oiio_backend(const std::string& subject) {
         backend = fn();
         return;
       }
+      failure = c + ": not emaki's OpenImageIO plugin";
+      return;
     }
-    if (failure.empty()) failure = "libemaki_io_oiio.so not found";
+    failure = "libemaki_io_oiio.so not found";
   });
   if (!backend) throw Error(subject, "cannot load the OpenImageIO plugin (" + failure + ")");
   return *backend;

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -148,6 +150,32 @@ TEST_F(ImageIo, FloatExrRoundTripIsExactWithNamedChannels) {
   ASSERT_EQ(two.channels(), 2);
   EXPECT_EQ(two(5, 4, 0), im(5, 4, 2));
   EXPECT_EQ(two(5, 4, 1), im(5, 4, 0));
+}
+
+// The first plugin found is the one: when it cannot load, the error says why (here: not a shared
+// object; in an install, the library it needs that is missing) instead of another build's plugin
+// loading silently. In a fresh process ("threadsafe" death test): the plugin is loaded once per
+// process.
+TEST_F(ImageIo, APluginThatCannotLoadIsTheErrorNotAFallBack) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const std::string plugin = p("libemaki_io_oiio.so"), exr = p("a.exr");
+  std::ofstream(plugin) << "not a shared object\n";
+  EXPECT_EXIT(
+      {
+        ::setenv("EMAKI_OIIO_MODULE", plugin.c_str(), 1);
+        int code = 0;
+        try {
+          WriteOptions o;
+          o.format = SampleFormat::kHalf;
+          write_image(exr, ramp(4, 3, 3, 7).cview(), o);
+        } catch (const Error& e) {
+          std::fprintf(stderr, "%s\n", e.what());
+          code = fs::exists(exr) ? 4 : 3;
+        }
+        fs::remove_all(dir_);
+        std::exit(code);
+      },
+      ::testing::ExitedWithCode(3), "cannot load the OpenImageIO plugin .*libemaki_io_oiio.so");
 }
 
 TEST_F(ImageIo, HalfExrKeepsHalfPrecision) {

@@ -12,6 +12,10 @@
 
 namespace emaki::scene {
 
+// The automatic camera's default elevation, degrees above the horizon (source.camera.elevation,
+// `emaki render --elevation`, emaki.render(elevation=)).
+inline constexpr float kDefaultAutoElevationDeg = 15.0f;
+
 struct CameraSpec {
   enum class Mode {
     kAuto,    // look at the shot's bounds from (azimuth, elevation), distance fitted to them
@@ -21,11 +25,11 @@ struct CameraSpec {
   Mode mode = Mode::kAuto;
   glm::vec3 position{0.0f, 0.0f, 5.0f};
   glm::vec3 target{0.0f};
-  bool has_target = false;      // kAuto: aim at `target` instead of the bounds' centre
-  float azimuth_deg = 30.0f;    // kAuto: around +Y, 0 = looking from +Z (glTF front)
-  float elevation_deg = 15.0f;  // kAuto: above the horizon
-  float distance = 0.0f;        // kAuto: 0 = fit the bounds
-  float fov_deg = 40.0f;        // vertical field of view, degrees; camera_at clamps to [0.1, 170]
+  bool has_target = false;    // kAuto: aim at `target` instead of the bounds' centre
+  float azimuth_deg = 30.0f;  // kAuto: around +Y, 0 = looking from +Z (glTF front)
+  float elevation_deg = kDefaultAutoElevationDeg;  // kAuto: above the horizon
+  float distance = 0.0f;                           // kAuto: 0 = fit the bounds
+  float fov_deg = 40.0f;  // vertical field of view, degrees; camera_at clamps to [0.1, 170]
   bool orthographic = false;
   float ortho_height = 0.0f;  // full visible height in scene units; 0 = fit the shot's bounds
   int gltf_node = -1;

@@ -93,6 +93,26 @@ std::string error_of(const std::string& layer_line) {
   return "";
 }
 
+// A matcap exemplar without `elevation` gets the reference camera's one default, the value the
+// table (and so the docs) shows; python/tests/test_defaults.py holds the other front ends to it.
+TEST(Schema, ExemplarElevationDefaultIsTheReferenceCamerasDefault) {
+  const std::string data = EMAKI_TEST_DATA;
+  const std::string text =
+      "[source]\nscene = \"" + data +
+      "/scenes/Fox.glb\"\nframes = [0, 3]\nsize = [64, 48]\n"
+      "[exemplars.sphere]\npainting = \"" +
+      data + "/stylit/source_style.png\"\n[layers.base]\nkind = \"base\"\n" +
+      "exemplar = \"sphere\"\n[outputs]\nfolder = \"/tmp/emaki_schema_test_out\"\n";
+  const pipeline::Shot shot = parse_shot(text, "/tmp/shot.toml");
+  ASSERT_EQ(shot.exemplars.size(), 1u);
+  EXPECT_EQ(shot.exemplars[0].reference.elevation_deg, exemplar::kDefaultReferenceElevationDeg);
+  const KeySpec* key = find_key("exemplars.NAME.elevation");
+  ASSERT_TRUE(key);
+  std::ostringstream shown;
+  shown << "`" << exemplar::kDefaultReferenceElevationDeg << "`";
+  EXPECT_EQ(key->default_value, shown.str());
+}
+
 // The parser's ranges are the table's: a value just outside each layer number's range is an
 // error naming the key and the range the docs show.
 TEST(Schema, ParserChecksTheTablesRanges) {

@@ -3,11 +3,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 
 #include "core/error.h"
+#include "core/version.h"
+#include "store/settings_manifests.h"
 
 namespace emaki::io {
 namespace {
@@ -55,6 +58,19 @@ TEST_F(OutputStore, ManifestsRoundTripAndNameTheFirstChange) {
   EXPECT_EQ(manifest_difference(m, changed), "size was 32x24, now 40x30");
   changed.push_back("layers.base.channel = 0");
   EXPECT_EQ(manifest_difference(m, {m[0], m[1], m[2], changed[3]}), "layers.base.channel is new");
+}
+
+TEST_F(OutputStore, ManifestsNameTheVersionButCompareWithoutIt) {
+  const Manifest m = frames_manifest(pipeline::Shot{});
+  const std::string line = std::string(kVersionKey) + " = " + version();
+  EXPECT_NE(std::find(m.begin(), m.end(), line), m.end());
+  Manifest older, without;
+  for (const std::string& l : m) {
+    older.push_back(l == line ? std::string(kVersionKey) + " = 0.0.1" : l);
+    if (l != line) without.push_back(l);
+  }
+  EXPECT_TRUE(manifest_current(older, m));
+  EXPECT_TRUE(manifest_current(without, m));
 }
 
 TEST_F(OutputStore, FileDigestFollowsContent) {

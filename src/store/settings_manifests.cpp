@@ -6,6 +6,8 @@
 #include <glm/glm.hpp>
 #include <set>
 
+#include "core/version.h"
+
 namespace emaki::io {
 
 namespace fs = std::filesystem;
@@ -129,6 +131,7 @@ void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
 Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer) {
   Lines l;
   l.add("outputs_format", kOutputsFormat);
+  l.add(kVersionKey, version());
   add_source(l, shot);
   const std::string p = "layers." + layer.name + ".";
   l.add(p + "exemplar", layer.exemplar);
@@ -164,6 +167,7 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
 Manifest passes_manifest(const pipeline::Shot& shot) {
   Lines l;
   l.add("outputs_format", kOutputsFormat);
+  l.add(kVersionKey, version());
   add_source(l, shot);
   // An automatic camera frames the whole range.
   l.add("source.last_frame", shot.source.last_frame);
@@ -173,6 +177,7 @@ Manifest passes_manifest(const pipeline::Shot& shot) {
 Manifest frames_manifest(const pipeline::Shot& shot) {
   Lines l;
   l.add("outputs_format", kOutputsFormat);
+  l.add(kVersionKey, version());
   l.add("size", fmt::format("{}x{}", shot.source.width, shot.source.height));
   // The layered EXR's channels: one group per layer, in compositing order.
   for (const pipeline::Layer& layer : shot.layers)
@@ -195,7 +200,7 @@ Manifest comparable(const Manifest& m) {
   Manifest out;
   for (const std::string& line : m) {
     const std::string key = key_of(line);
-    if (digested.count(key)) continue;
+    if (digested.count(key) || key == kVersionKey) continue;
     if (key == "source.sequence" && line.size() > key.size() + 3)
       out.push_back(key + " = " + canonical_pattern(line.substr(key.size() + 3)));
     else

@@ -12,6 +12,10 @@ namespace emaki::io {
 
 // Bumped when emaki's output files change meaning (channel layout, synthesis algorithm).
 inline constexpr int kOutputsFormat = 1;
+// Every manifest's line `emaki_version = 0.1.0+g...` (core/version.h): the emaki that recorded
+// the settings. Informative only: the comparison leaves it out (kOutputsFormat is what makes a
+// new emaki redo old outputs), and older manifests without it are current.
+inline constexpr const char* kVersionKey = "emaki_version";
 
 Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer);
 Manifest frames_manifest(const pipeline::Shot& shot);

@@ -8,10 +8,10 @@
 #   blender -b -P tools/blender/emaki_passes.py -- --reference --out DIR      # reference sphere
 #   blender -b -P tools/blender/emaki_passes.py -- --gltf scene.glb --out DIR --frames 0-4
 #
-# `-- --help` lists every option. Installed as an add-on (Edit > Preferences > Add-ons >
-# Install... this file, with emaki_stylize.py beside it: install a zip of the two), it adds an
-# "emaki" panel to the Output properties: render the passes of the frame range, and stylize the
-# current frame in Blender through emaki's Python module (emaki_stylize.py).
+# `-- --help` lists every option. As part of the add-on (the package emaki_blender/, whose
+# __init__.py holds bl_info; the build zips it, docs/blender.md), it adds an "emaki" panel to the
+# Output properties: render the passes of the frame range, and stylize the current frame in
+# Blender through emaki's Python module (emaki_stylize.py).
 #
 # How each pass is made (docs/blender.md has the conventions):
 #   normal, position, position_norm, rest_position, depth: a shader AOV written by a node group
@@ -37,16 +37,6 @@ import sys
 
 import bpy
 import mathutils
-
-bl_info = {
-    "name": "emaki passes",
-    "author": "emaki",
-    "version": (0, 1, 0),
-    "blender": (3, 4, 0),
-    "location": "Properties > Output > emaki",
-    "description": "Render emaki's guide passes (multilayer EXR) and its reference sphere",
-    "category": "Render",
-}
 
 GROUP = "emaki_passes"
 AOVS = [  # name, type
@@ -674,6 +664,8 @@ def parse_args(argv):
     p.add_argument("--reference", action="store_true",
                    help="render the reference sphere instead of the open scene")
     p.add_argument("--sphere", help="reference: CX,CY,R pixels (default: centred, 30%% of h)")
+    # emaki's one default for the reference camera (exemplar::kDefaultReferenceElevationDeg;
+    # python/tests/test_defaults.py checks that they agree).
     p.add_argument("--elevation", type=float, default=10.0, help="reference: degrees (10)")
     p.add_argument("--fov", type=float, help="vertical field of view, degrees (reference: 30, "
                    "--look-from: 40)")

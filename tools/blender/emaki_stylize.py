@@ -1,14 +1,17 @@
 # The emaki add-on's "Stylize current frame" action (registered by emaki_passes.py, which must
-# sit beside this file): renders the current frame's guide passes through the exporter, then
+# sit beside this file, as it does in the add-on's package emaki_blender/): renders the current frame's guide passes through the exporter, then
 # stylizes the frame in this Blender process through emaki's Python module (emaki.synthesize),
 # as a `base` layer would (guides normal 1 + diffuse 1, the frame's coverage as the mask), and
 # shows the result as an image ("emaki frame NNNN") in an Image Editor.
 #
 # The module: build/release/python/emaki*.so, built for Debian's Python 3.11, which Debian's
 # Blender runs. Blender ignores PYTHONPATH unless started with --python-use-system-env, so the
-# panel has a "Module folder" setting (also read from the environment variable EMAKI_PYTHONPATH).
+# panel has a "Module folder" setting (also read from the environment variable EMAKI_PYTHONPATH);
+# without one, the module is looked for in the install of the emaki executable the add-on's
+# preference names (else `emaki` on PATH): PREFIX/lib/python3/dist-packages.
 
 import os
+import shutil
 import sys
 
 import bpy
@@ -21,9 +24,21 @@ class StylizeError(Exception):
     pass
 
 
+def installed_module_folder():
+    """PREFIX/lib/python3/dist-packages of the emaki executable the add-on uses (its preference,
+    else PATH; docs/install.md), or ""."""
+    addon = sys.modules.get("emaki_blender")
+    exe = addon.emaki_executable() if addon else shutil.which("emaki")
+    if not exe:
+        return ""
+    prefix = os.path.dirname(os.path.dirname(os.path.realpath(exe)))
+    return os.path.join(prefix, "lib", "python3", "dist-packages")
+
+
 def import_emaki(folder):
-    """The emaki module, from `folder` (or EMAKI_PYTHONPATH) when it is not importable as is."""
-    for extra in (folder, os.environ.get("EMAKI_PYTHONPATH", "")):
+    """The emaki module, from `folder` (or EMAKI_PYTHONPATH, or the install of the emaki
+    executable) when it is not importable as is."""
+    for extra in (folder, os.environ.get("EMAKI_PYTHONPATH", ""), installed_module_folder()):
         extra = bpy.path.abspath(extra) if extra else ""
         if extra and extra not in sys.path:
             sys.path.insert(0, extra)
@@ -31,7 +46,7 @@ def import_emaki(folder):
         import emaki
     except ImportError as e:
         raise StylizeError("cannot import emaki's Python module (%s): set the module folder "
-                           "(build/release/python)" % e)
+                           "(build/release/python, or PREFIX/lib/python3/dist-packages)" % e)
     return emaki
 
 
