@@ -300,6 +300,21 @@ std::optional<AnyImage> read_image_if_complete(const std::string& path,
   return read_open_file(f.get(), path, options, false);
 }
 
+std::vector<std::string> list_channels_memory(const void* data, std::size_t size,
+                                              const std::string& name) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  if (has_png_signature(bytes, size) || lower_ext(name) == ".png")
+    return detail::read_png_memory(data, size, name).channel_names;  // decoded: PNGs are small
+  if (lower_ext(name) == ".exr" || detail::has_exr_magic(bytes, size))
+    detail::check_exr_header(bytes, size, name);
+  std::vector<std::string> names;
+  std::lock_guard lock(detail::oiio_mutex());
+  if (std::string e = detail::oiio_backend(name).list_channels({name, data, size}, names);
+      !e.empty())
+    throw Error(name, e);
+  return names;
+}
+
 AnyImage read_image_memory(const void* data, std::size_t size, const std::string& name,
                            const ReadOptions& options) {
   if (has_png_signature(static_cast<const unsigned char*>(data), size) || lower_ext(name) == ".png")

@@ -61,6 +61,9 @@ AnyImage read_image_memory(const void* data, std::size_t size, const std::string
 
 // Lists the channel names of every part of a file.
 std::vector<std::string> list_channels(const std::string& path);
+// The same from `size` bytes in memory; `name` as read_image_memory takes it.
+std::vector<std::string> list_channels_memory(const void* data, std::size_t size,
+                                              const std::string& name);
 
 enum class SampleFormat { kAuto, kU8, kU16, kHalf, kFloat };
 

@@ -58,9 +58,14 @@ constexpr ShotKey kShotKeys[] = {
 // larger one is read the ordinary way.
 constexpr std::size_t kMaxInputBytes = std::size_t(1) << 30;
 
-// An input image read once: its bytes decoded, and digested for the manifests (file_digest).
+// An input file's bytes, read once for its decoding and its digest (file_digest); empty when it
+// is left to the readers that take a path (which word the errors).
+std::optional<std::string> input_bytes(const std::string& path) {
+  return io::read_input_file(path, kMaxInputBytes);
+}
+
 Image<float> read_input_image(const std::string& path, const ReadOptions& options = {}) {
-  if (const std::optional<std::string> bytes = io::read_input_file(path, kMaxInputBytes))
+  if (const std::optional<std::string> bytes = input_bytes(path))
     return io::read_image_memory(bytes->data(), bytes->size(), path, options).to_float();
   return io::read_image_float(path, options);
 }
@@ -124,7 +129,10 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
     } else {
       // The passes the layers use as guides, read in one go; the rest stay zero.
       im.passes = Image<float>(w, h, render::kChannelCount);
-      const std::vector<std::string> have = io::list_channels(e.passes);
+      const std::optional<std::string> bytes = input_bytes(e.passes);
+      const std::vector<std::string> have =
+          bytes ? io::list_channels_memory(bytes->data(), bytes->size(), e.passes)
+                : io::list_channels(e.passes);
       std::vector<std::string> names;  // the file's channels to read
       std::vector<int> into;           // parallel: the channel of im.passes each fills
       for (const pipeline::Layer& l : shot.layers) {
@@ -152,7 +160,10 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
         }
       }
       if (!names.empty()) {
-        const Image<float> pass = read_input_image(e.passes, ReadOptions{names});
+        const Image<float> pass = bytes ? io::read_image_memory(bytes->data(), bytes->size(),
+                                                                e.passes, ReadOptions{names})
+                                              .to_float()
+                                        : io::read_image_float(e.passes, ReadOptions{names});
         if (pass.width() != w || pass.height() != h)
           throw Error(key + ".passes",
                       fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}", e.passes,
