@@ -1,27 +1,27 @@
 #!/bin/bash
-# The bundled production (examples/production: 3 shots at 480x270, 60 frames, 3 layers each)
-# through Slurm on this machine, against `emaki run` of each shot in turn, and the scheduler's
-# per-task overhead. Prints figures; asserts nothing.
-#   bench/farm_bench.sh [EMAKI] [WORK_DIR]
-# Three runs over the same shots, each into its own output folders:
-#   run     `emaki run SHOT` for each shot in turn (all cores)
-#   local   the plan's tasks run here without a scheduler, stage by stage, as many at once as
-#           there are cores (xargs -P): the same work and the same parallelism, no Slurm
+# The bundled production (examples/production: 3 shots at 480x270, 60 frames, 3 layers each):
+# what the farm's tasks cost against `emaki run` of the same shots, in CPU-seconds and wall
+# time per stage, and through Slurm on this machine. Prints figures; asserts nothing.
+#   bench/farm_bench.sh [EMAKI] [WORK_DIR]      (FARM_BENCH_SLURM=0: leave Slurm out)
+# Each run writes its own output folders:
+#   run     `emaki run SHOT --threads 1` for each shot in turn
+#   tasks   the plan's tasks (`--threads 1`) run here one by one, stage by stage, without a
+#           scheduler: the work a farm's nodes do, each task's CPU time (user + system) summed
+#           per stage. Its outputs must be byte-identical to `run`'s.
 #   slurm   `emaki farm submit` on the private cluster (scripts/slurm/start.sh), waited for
 # The scheduler's per-task overhead: from the tasks' own start/end stamps, the mean time from
-# the end of the stage a task waits for to its start, when a CPU was free. (`local` has a
-# barrier between stages across all shots where Slurm has one per shot, so slurm - local is
-# not an overhead.) Also the CPU-seconds per task kind.
+# the end of the stage a task waits for to its start, when a CPU was free.
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
 emaki=${1:-$root/build/release/apps/emaki/emaki}
 work=${2:-/tmp/emaki_farm_bench}
+use_slurm=${FARM_BENCH_SLURM:-1}
 chunk=8
 cores=$(nproc)
 rm -rf "$work"
 mkdir -p "$work"
 state=$work/cluster
-trap '"$root/scripts/slurm/stop.sh" "$state" >/dev/null 2>&1' EXIT
+trap '[ "$use_slurm" = 1 ] && "$root/scripts/slurm/stop.sh" "$state" >/dev/null 2>&1' EXIT
 
 # The production's shots with absolute paths and their output in $work/$1/.
 copy_shots() {
@@ -34,24 +34,69 @@ copy_shots() {
 now() { date +%s.%N; }
 secs() { awk -v a="$1" -v b="$2" 'BEGIN { print b - a }'; }
 calc() { awk "BEGIN { printf \"%.2f\", $1 }"; }
+# timed CMD...: runs it, prints "WALL CPU" (CPU = user + system, seconds).
+timed() {
+  /usr/bin/time -f "%e %U %S" -o "$work/time" "$@" >/dev/null 2>"$work/stderr" ||
+    echo "failed: $* ($(tail -n 1 "$work/stderr"))" >&2
+  tail -n 1 "$work/time" | awk '{ printf "%.2f %.2f\n", $1, $2 + $3 }'
+}
+# The MP4 is left out: libx264 here encodes the same PNGs to different bytes from one run to the
+# next (two `emaki task previews` of one folder differed).
+outputs_md5() {
+  (cd "$1" && find . -type f ! -name '.emaki*' ! -path './farm/*' ! -path './passes/*' \
+    ! -path './references/*' ! -name preview.mp4 -exec md5sum {} + | sort -k 2)
+}
+# same DIR_A DIR_B: "identical" when every shot's outputs match byte for byte.
+same() {
+  local r=identical
+  for s in sh010 sh020 sh030; do
+    [ "$(outputs_md5 "$1/$s")" = "$(outputs_md5 "$2/$s")" ] || r="DIFFERENT ($s)"
+  done
+  echo "$r"
+}
 
 copy_shots run
-t=$(now)
-for s in "$work"/run/*.toml; do "$emaki" run "$s" 2>/dev/null || echo "emaki run $s failed"; done
-run_s=$(secs "$t" "$(now)")
+run_wall=0 run_cpu=0
+for s in "$work"/run/*.toml; do
+  read -r w c < <(timed "$emaki" run "$s" --threads 1)
+  run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
+done
 
-copy_shots local
-"$emaki" plan "$work"/local/*.toml --chunk $chunk --json >"$work/local/plan.json"
-tasks=$(grep -c '"id":' "$work/local/plan.json")
-t=$(now)
+copy_shots tasks
+"$emaki" plan "$work"/tasks/*.toml --chunk $chunk --threads 1 --json >"$work/tasks/plan.json"
+tasks=$(grep -c '"id":' "$work/tasks/plan.json")
+declare -A stage_wall stage_cpu stage_n
 for kind in prepare passes layer composite previews; do
-  /usr/bin/python3 -c '
+  stage_wall[$kind]=0 stage_cpu[$kind]=0 stage_n[$kind]=0
+  while IFS= read -r -d '' line; do
+    eval "set -- $line"
+    read -r w c < <(timed "$@")
+    stage_wall[$kind]=$(calc "${stage_wall[$kind]} + $w")
+    stage_cpu[$kind]=$(calc "${stage_cpu[$kind]} + $c")
+    stage_n[$kind]=$((stage_n[$kind] + 1))
+  done < <(/usr/bin/python3 -c '
 import json, shlex, sys
 for t in json.load(open(sys.argv[1]))["tasks"]:
-    if t["kind"] == sys.argv[2]: print(" ".join(shlex.quote(a) for a in t["argv"]))
-' "$work/local/plan.json" "$kind" | xargs -P "$cores" -I{} sh -c '{} 2>/dev/null || echo "task failed: {}"'
+    if t["kind"] == sys.argv[2]: sys.stdout.write(" ".join(shlex.quote(a) for a in t["argv"]) + "\0")
+' "$work/tasks/plan.json" "$kind")
 done
-local_s=$(secs "$t" "$(now)")
+tasks_wall=0 tasks_cpu=0
+for kind in prepare passes layer composite previews; do
+  tasks_wall=$(calc "$tasks_wall + ${stage_wall[$kind]}")
+  tasks_cpu=$(calc "$tasks_cpu + ${stage_cpu[$kind]}")
+done
+
+echo "production: 3 shots, 480x270, 60 frames, 3 layers; $tasks tasks (chunk $chunk, 1 thread each)"
+printf '%-34s %9s %9s\n' "" "wall s" "CPU s"
+printf '%-34s %9.1f %9.1f\n' "emaki run of each shot, 1 thread" "$run_wall" "$run_cpu"
+for kind in prepare passes layer composite previews; do
+  printf '%-34s %9.1f %9.1f\n' "  tasks: $kind (${stage_n[$kind]})" "${stage_wall[$kind]}" \
+    "${stage_cpu[$kind]}"
+done
+printf '%-34s %9.1f %9.1f\n' "the plan's tasks one by one" "$tasks_wall" "$tasks_cpu"
+echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x CPU time"
+echo "outputs (but the MP4), tasks vs emaki run: $(same "$work/run" "$work/tasks")"
+[ "$use_slurm" = 1 ] || exit 0
 
 copy_shots slurm
 eval "$("$root/scripts/slurm/start.sh" "$state")"
@@ -60,13 +105,6 @@ t=$(now)
 while [ -n "$(squeue -h -o %i)" ]; do sleep 0.2; done
 slurm_s=$(secs "$t" "$(now)")
 "$emaki" farm status "$work"/slurm/*.toml --chunk $chunk | tail -n 1
-
-same=identical
-for s in sh010 sh020 sh030; do
-  a=$(cd "$work/run/$s" && find . -type f ! -name '.emaki*' ! -path './farm/*' ! -path './passes/*' -exec md5sum {} + | sort -k 2)
-  b=$(cd "$work/slurm/$s" && find . -type f ! -name '.emaki*' ! -path './farm/*' ! -path './passes/*' -exec md5sum {} + | sort -k 2)
-  [ "$a" = "$b" ] || same="DIFFERENT ($s)"
-done
 
 # Dispatch latency: per task, its start minus the end of the last task of the stage before it
 # (its dependency), for tasks that started within 5 s of it (a CPU was free).
@@ -101,10 +139,7 @@ for farm in glob.glob(os.path.join(sys.argv[1], "*", "farm", "status")):
 print("task seconds: " + ", ".join(f"{k} {n} x {s / n:.1f} s" for k, (n, s) in sorted(cpu.items())))
 PY
 )
-echo "production: 3 shots, 480x270, 60 frames, 3 layers; $tasks tasks (chunk $chunk), $cores cores"
-printf '%-44s %8.1f s\n' "emaki run of each shot in turn" "$run_s"
-printf '%-44s %8.1f s\n' "plan's tasks here, no scheduler (xargs -P$cores)" "$local_s"
-printf '%-44s %8.1f s\n' "emaki farm submit on Slurm, to all done" "$slurm_s"
-echo "slurm vs emaki run: $(calc "$slurm_s / $run_s")x wall time"
+printf '%-44s %8.1f s\n' "emaki farm submit on Slurm ($cores cores), to all done" "$slurm_s"
+echo "slurm vs emaki run (1 thread, one shot after another): $(calc "$slurm_s / $run_wall")x wall time"
 echo "Slurm's per-task overhead (dispatch after the stage waited for ends): $latency"
-echo "outputs, slurm vs emaki run: $same"
+echo "outputs (but the MP4), slurm vs emaki run: $(same "$work/run" "$work/slurm")"

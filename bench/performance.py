@@ -407,7 +407,8 @@ def main():
         "- `bench/python_overhead.py` (the module's cost over the command line's synthesis, in "
         "instructions with `--instructions`) and `bench/python_gil.py` (two Python threads "
         "synthesizing at once).",
-        "- `bench/farm_bench.sh` (the bundled production through Slurm against `emaki run`) and "
+        "- `bench/farm_bench.sh` (the bundled production's tasks, CPU-seconds and wall time per "
+        "stage, and through Slurm, against `emaki run`) and "
         "`bench/slurm_overhead.sh` (the scheduler's cost per task, [slurm.md](slurm.md)).",
         "- Instruction counts, which other jobs do not disturb: `valgrind --tool=callgrind` of "
         "`emaki synth ... --threads 1` ([design/engine-speed.md](design/engine-speed.md))."]

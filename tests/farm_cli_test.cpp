@@ -158,4 +158,29 @@ TEST_F(FarmCli, ATaskLogStartsWithTheVersion) {
   EXPECT_EQ(r.out, std::string("emaki task: emaki ") + version() + "\n");
 }
 
+TEST_F(FarmCli, FarmHelpExitsZero) {
+  const test::CliResult r = emaki({"farm", "--help"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("status"), std::string::npos) << r.out;
+}
+
+// Slurm's client without a configuration (no SLURM_CONF, no slurm.conf) says so in many lines;
+// emaki says it in one.
+TEST_F(FarmCli, SlurmWithoutAConfigurationIsAOneLineError) {
+  fs::create_directories(dir_ / "bin");
+  std::ofstream(dir_ / "bin/squeue")
+      << "#!/bin/sh\necho 'squeue: error: resolve_ctls_from_dns_srv: res_nsearch error: Unknown "
+         "host' >&2\necho 'squeue: fatal: Could not establish a configuration source' >&2\n"
+         "exit 1\n";
+  fs::permissions(dir_ / "bin/squeue", fs::perms::owner_all, fs::perm_options::add);
+  const fs::path shot = write_shot("a.toml", "out");
+  test::CliOptions o;
+  o.cwd = dir_;
+  o.env = {"PATH=" + (dir_ / "bin").string() + ":/usr/bin:/bin"};
+  for (const char* command : {"status", "cancel"}) {
+    const test::CliResult r = test::run_cli(EMAKI_BINARY, {"farm", command, shot.string()}, o);
+    expect_error(r, "not configured");
+  }
+}
+
 }  // namespace

@@ -8,6 +8,8 @@
 #   3. a shot with a bad input (a truncated glTF) fails its task, its compositing never runs,
 #      `emaki farm status` names the failing task and its error line, and the other shot of the
 #      same submission completes.
+# Along the way: `submit` prints its job ids, `status` plans with the recorded chunk, its --json
+# and its exit code (0 all done, 4 after the cancelled task).
 # The cluster stops however the test ends. Exits 77 (CTest skip) without Slurm.
 # Usage: farm_slurm_test.sh REPO_ROOT EMAKI_BINARY WORK_DIR
 set -u
@@ -101,6 +103,12 @@ echo "two shots through Slurm: $((SECONDS - t0)) s"
 status=$("$emaki" farm status "$work/a.toml" "$work/b.toml" --chunk 3)
 echo "$status" | tail -n 1
 echo "$status" | grep -vE ' done |^[0-9]+ done$' && fail "a task of a or b is not done"
+# The same as JSON, and an exit code saying all is done (no --chunk: submit recorded it).
+"$emaki" farm status "$work/a.toml" "$work/b.toml" --json >"$work/status.json"
+rc=$?
+[ "$rc" -eq 0 ] || fail "status --json of finished shots exits $rc"
+/usr/bin/python3 -c 'import json, sys; t = json.load(open(sys.argv[1])); assert t and all(x["state"] == "done" and x["job"] for x in t)' \
+  "$work/status.json" || fail "status --json: $(head -c 300 "$work/status.json")"
 same_outputs "$work/ref_a" "$work/a"
 same_outputs "$work/ref_b" "$b_out"
 [ -e "$work/pwned" ] && fail "a command in b's folder name ran"
@@ -113,7 +121,10 @@ echo "$again" | grep -q "0 tasks in 0 job arrays submitted" || fail "resubmittin
 shot c 11 "320, 180"
 sed "s|folder = \"$work/c\"|folder = \"$work/ref_c\"|" "$work/c.toml" >"$work/ref_c.toml"
 "$emaki" run "$work/ref_c.toml" --threads 1 2>/dev/null || fail "emaki run ref_c"
-"$emaki" farm submit "$work/c.toml" --chunk 4 || fail "submit c"
+ids=$("$emaki" farm submit "$work/c.toml" --chunk 4) || fail "submit c"
+# One line per job array queued: JOBID, job name, tasks.
+echo "$ids" | awk -F'\t' 'NF != 3 || $1 !~ /^[0-9]+$/ || $2 !~ /^emaki:c-/ { bad = 1 } END { exit bad }' ||
+  fail "submit's job ids: $ids"
 running=""
 end=$((SECONDS + 120))
 while [ -z "$running" ] && [ $SECONDS -lt $end ]; do
@@ -128,6 +139,9 @@ wait_queue 120
 status=$("$emaki" farm status "$work/c.toml" --chunk 4)
 echo "$status" | grep -qE "^c-[0-9a-f]+\.layer\.base\.0-11 +failed +.*stopped while running" || fail "the cancelled task is not reported stopped while running"
 echo "$status" | grep -E '^c-[0-9a-f]+\.composite' | grep -q 'done' && fail "compositing ran after a cancelled layer"
+"$emaki" farm status "$work/c.toml" >/dev/null
+rc=$?
+[ "$rc" -eq 4 ] || fail "status after a cancelled task exits $rc, not 4"
 echo "$status" | tail -n 1
 leftovers=$(find "$work/c" -name '.*.emaki-tmp-*' | wc -l)
 echo "temporaries the cancelled task left: $leftovers"

@@ -57,6 +57,25 @@ struct PlanArgs {
     for (const std::string& s : shots) paths.push_back(fs::absolute(s).lexically_normal().string());
     return shot::plan(paths, o);
   }
+  // The plan cut as the shots were submitted (farm/chunk, farm/threads): task ids name their
+  // frames, so status and cancel plan with the submission's settings unless given them again.
+  // A different value given on the command line is an error naming it.
+  shot::Plan make_as_submitted(const CLI::App& app) {
+    shot::Plan plan = make();
+    bool changed = false;
+    const auto adopt = [&](const char* option, const char* name, int& value,
+                           std::optional<int> recorded) {
+      if (!recorded || *recorded == value) return;
+      if (app.count(option) > 0)
+        throw Error(Error::Field{name}, fmt::format("the shots were submitted with {} {}, not {}",
+                                                    name, *recorded, value));
+      value = *recorded;
+      changed = true;
+    };
+    adopt("--chunk", "chunk", chunk, farm::submitted_chunk(plan));
+    adopt("--threads", "threads", threads, farm::submitted_threads(plan));
+    return changed ? make() : plan;
+  }
 };
 
 void print_plan(const shot::Plan& plan) {
@@ -90,28 +109,31 @@ int farm_submit(const Args& args) {
     std::fprintf(stderr, "emaki farm: submitted %s\n", script.c_str());
   std::fprintf(stderr, "emaki farm: %d tasks in %d job arrays submitted, %d finished already\n",
                s.tasks, s.jobs, s.done);
+  // For scripts: each job array queued, "JOBID<tab>JOB NAME<tab>TASKS", on stdout.
+  for (const farm::SubmittedArray& a : s.arrays)
+    std::printf("%s\t%s\t%d\n", a.job.c_str(), a.name.c_str(), a.tasks);
   return 0;
 }
 
 int farm_status(const Args& args) {
   CLI::App app{
       "Each task of the shots: pending, running, done, failed (with its log and error "
-      "line) or not run.",
+      "line) or not run. Exit code: 0 all done, 3 some still queued or running, 4 some "
+      "failed or not run, 5 some not submitted.",
       "emaki farm status"};
   PlanArgs p;
+  bool json = false;
   p.bind(app);
+  app.add_flag("--json", json, "one JSON object per task (docs/farm.md)");
   if (parse_cli(app, args)) return 0;
-  shot::Plan plan = p.make();
-  // Task ids name their frames: plan as the shots were submitted.
-  if (const std::optional<int> chunk = farm::submitted_chunk(plan); chunk && *chunk != p.chunk) {
-    if (app.count("--chunk") > 0)
-      throw Error(Error::Field{"chunk"},
-                  fmt::format("the shots were submitted with chunk {}, not {}", *chunk, p.chunk));
-    p.chunk = *chunk;
-    plan = p.make();
+  const shot::Plan plan = p.make_as_submitted(app);
+  const std::vector<farm::TaskStatus> states = farm::status(plan);
+  if (json) {
+    std::printf("%s", farm::status_json(plan, states).c_str());
+    return farm::status_exit_code(states);
   }
   std::map<std::string, int> count;
-  for (const farm::TaskStatus& st : farm::status(plan)) {
+  for (const farm::TaskStatus& st : states) {
     const char* state = farm::task_state_name(st.state);
     ++count[state];
     std::printf("%-40s %-13s %-10s %s\n", st.task->id.c_str(), state, st.job.c_str(),
@@ -121,7 +143,7 @@ int farm_status(const Args& args) {
   for (const auto& [state, n] : count)
     summary += fmt::format("{}{} {}", summary.empty() ? "" : ", ", n, state);
   std::printf("%s\n", summary.c_str());
-  return 0;
+  return farm::status_exit_code(states);
 }
 
 int farm_cancel(const Args& args) {
@@ -129,7 +151,7 @@ int farm_cancel(const Args& args) {
   PlanArgs p;
   p.bind(app);
   if (parse_cli(app, args)) return 0;
-  const int n = farm::cancel(p.make());
+  const int n = farm::cancel(p.make_as_submitted(app));
   std::fprintf(stderr, "emaki farm: cancelled %d job arrays\n", n);
   return 0;
 }
@@ -166,6 +188,19 @@ int run_farm(const Args& args) {
     return 0;
   }
   if (args.empty()) throw Error("", usage);
+  if (args[0] == "--help" || args[0] == "-h") {
+    std::printf(
+        "%s\n\n"
+        "  submit   queues the shots' unfinished tasks as Slurm job arrays; prints\n"
+        "           JOBID<tab>NAME<tab>TASKS for each array queued\n"
+        "  status   each task's state; exit 0 all done, 3 queued or running, 4 failed or\n"
+        "           not run, 5 not submitted (--json: one object per task)\n"
+        "  cancel   cancels the shots' queued and running jobs\n\n"
+        "status and cancel plan with the chunk and threads submit recorded under\n"
+        "OUTPUT/farm. docs/farm.md has the details.\n",
+        usage.c_str());
+    return 0;
+  }
   const Args rest(args.begin() + 1, args.end());
   if (args[0] == "submit") return farm_submit(rest);
   if (args[0] == "status") return farm_status(rest);

@@ -127,6 +127,18 @@ int parse_chunk(std::string_view text, const std::string& subject) {
   return chunk;
 }
 
+int parse_threads(std::string_view text, const std::string& subject) {
+  if (!text.empty() && text.back() == '\n') text.remove_suffix(1);
+  int threads = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), threads);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || threads < 1 ||
+      threads > 1024)
+    throw Error(subject, fmt::format("is not a number of threads in [1, 1024]: '{}'; submit the "
+                                     "shot again or pass --threads",
+                                     echo(text, 40)));
+  return threads;
+}
+
 std::optional<int> parse_exit_code(std::string_view text) {
   if (!text.empty() && text.back() == '\n') text.remove_suffix(1);
   if (!decimal(text) || text.size() > 3) return std::nullopt;

@@ -37,6 +37,10 @@ std::string job_record(const std::string& task, const std::string& job, std::siz
 // Error(subject) otherwise.
 int parse_chunk(std::string_view text, const std::string& subject);
 
+// farm/threads' text: one decimal number in [1, 1024] and a newline. Throws Error(subject)
+// otherwise.
+int parse_threads(std::string_view text, const std::string& subject);
+
 // A status/TASK.exit file's text: a decimal exit code in [0, 255] and a newline; nullopt
 // otherwise (a half-written or foreign file is no exit code).
 std::optional<int> parse_exit_code(std::string_view text);

@@ -97,6 +97,9 @@ TEST_F(FarmState, ChunksAndExitCodes) {
   EXPECT_EQ(parse_chunk("8\n", "chunk"), 8);
   for (const std::string bad : {"", "0", "x", "8 ", "-3", "99999999999"})
     EXPECT_THROW(parse_chunk(bad, "chunk"), Error) << bad;
+  EXPECT_EQ(parse_threads("4\n", "threads"), 4);
+  for (const std::string bad : {"", "0", "x", "4 ", "-3", "1025"})
+    EXPECT_THROW(parse_threads(bad, "threads"), Error) << bad;
   EXPECT_EQ(parse_exit_code("0\n"), 0);
   EXPECT_EQ(parse_exit_code("137\n"), 137);
   EXPECT_FALSE(parse_exit_code(""));

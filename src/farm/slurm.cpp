@@ -104,21 +104,21 @@ void append_jobs(const std::string& folder, const std::vector<const Task*>& task
   if (::close(fd) != 0) throw failed("close");
 }
 
-// farm/chunk: the chunk of the last submission, one decimal number.
-void record_chunk(const std::string& folder, int chunk) {
+// farm/chunk and farm/threads: the plan's cut at the last submission, one decimal number each.
+void record_setting(const std::string& folder, const char* name, int value) {
   fs::create_directories(folder);
-  const std::string path = folder + "/chunk";
+  const std::string path = folder + "/" + name;
   io::TempFile tmp(path, path);
-  const std::string text = fmt::format("{}\n", chunk);
+  const std::string text = fmt::format("{}\n", value);
   tmp.write(text.data(), text.size());
   tmp.commit();
 }
 
-std::optional<int> read_chunk(const std::string& folder) {
-  const std::string path = folder + "/chunk";
+std::optional<int> read_setting(const std::string& folder, const char* name) {
+  const std::string path = folder + "/" + name;
   const std::optional<std::string> text = read_state_file(path, kMaxSmallFileBytes);
   if (!text) return std::nullopt;
-  return parse_chunk(*text, path);
+  return std::string_view(name) == "chunk" ? parse_chunk(*text, path) : parse_threads(*text, path);
 }
 
 // The submitting user: squeue and scancel see no one else's jobs.
@@ -129,8 +129,7 @@ std::string user_id() {
 // The queue: "JOBID_INDEX" -> (state, reason, job name), every array element on its own line.
 std::map<std::string, QueuedJob> queue() {
   const ProcessResult r = run_process({"squeue", "-h", "-r", "-u", user_id(), "-o", "%i|%T|%r|%j"});
-  if (r.exit_code != 0)
-    throw Error("squeue", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
+  if (r.exit_code != 0) throw Error("squeue", slurm_failure("squeue", r.exit_code, r.err));
   return parse_queue(r.out);
 }
 
@@ -262,8 +261,8 @@ std::string sbatch(const std::string& script_path, const std::vector<std::string
   argv.push_back(script_path);
   const ProcessResult r = run_process(argv);
   if (r.exit_code != 0)
-    throw Error("sbatch", fmt::format("refused '{}' ({}): {}", echo_path(script_path), r.exit_code,
-                                      first_line(r.err)));
+    throw Error("sbatch", fmt::format("refused '{}': {}", echo_path(script_path),
+                                      slurm_failure("sbatch", r.exit_code, r.err)));
   std::string id = r.out.substr(0, r.out.find_first_of(";\n"));
   if (id.empty() || id.size() > 18 || id.find_first_not_of("0123456789") != std::string::npos)
     throw Error("sbatch",
@@ -279,8 +278,7 @@ void scancel(const std::map<std::string, std::string>& job_names) {
     std::vector<std::string> argv = {"scancel", "--user=" + user_id(), "--name=" + name};
     argv.insert(argv.end(), ids.begin(), ids.end());
     const ProcessResult r = run_process(argv);
-    if (r.exit_code != 0)
-      throw Error("scancel", fmt::format("failed ({}): {}", r.exit_code, first_line(r.err)));
+    if (r.exit_code != 0) throw Error("scancel", slurm_failure("scancel", r.exit_code, r.err));
   }
 }
 
@@ -315,7 +313,8 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
       // No task of the shot runs now: what a cancelled or killed task left half-written goes
       // (farm tasks leave clean-up to each other), as `emaki run` does when it starts.
       io::FileStore(plan.shots[std::size_t(s)].shot, io::StoreMode::kRun, io::StoreAccess::kAlone);
-      record_chunk(farm, plan.chunk);
+      record_setting(farm, "chunk", plan.chunk);
+      record_setting(farm, "threads", plan.threads);
     }
     std::map<std::string, std::string> job_of_task;  // this submission's
     for (shot::TaskKind kind :
@@ -353,6 +352,7 @@ Submitted submit(const Plan& plan, const SlurmOptions& o) {
           fs::remove(farm + fmt::format(fmt::runtime(f), t->id));
       const std::string job = submit_array(farm, path, tasks, job_name(plan, s, kind));
       for (const Task* t : tasks) job_of_task[t->id] = job;
+      out.arrays.push_back({job, job_name(plan, s, kind), int(tasks.size())});
       out.scripts.push_back(path);
     }
   }
@@ -398,7 +398,12 @@ TaskStatus status_of(const Plan& plan, const Task& t,
   if (const std::optional<int> code = exit_text ? parse_exit_code(*exit_text) : std::nullopt) {
     const std::string log = farm + "/logs/" + t.id + ".log";
     st.state = *code == 0 ? TaskState::kDone : TaskState::kFailed;
-    if (*code != 0) st.detail = fmt::format("exit {}; {}: {}", *code, log, error_line(log));
+    st.exit_code = code;
+    st.log = log;
+    if (*code != 0) {
+      st.error_line = error_line(log);
+      st.detail = fmt::format("exit {}; {}: {}", *code, log, st.error_line);
+    }
     return st;
   }
   if (t.done) {
@@ -409,7 +414,9 @@ TaskStatus status_of(const Plan& plan, const Task& t,
   std::error_code ec;
   if (!st.job.empty() && fs::is_regular_file(log, ec)) {
     st.state = TaskState::kFailed;
-    st.detail = fmt::format("stopped while running (cancelled or killed); {}", log);
+    st.log = log;
+    st.error_line = "stopped while running (cancelled or killed)";
+    st.detail = fmt::format("{}; {}", st.error_line, log);
     return st;
   }
   st.state = st.job.empty() ? TaskState::kNotSubmitted : TaskState::kNotRun;
@@ -429,22 +436,82 @@ std::vector<TaskStatus> status(const Plan& plan) {
   return out;
 }
 
-std::optional<int> submitted_chunk(const Plan& plan) {
-  std::optional<int> chunk;
+namespace {
+
+std::optional<int> submitted_setting(const Plan& plan, const char* name) {
+  std::optional<int> value;
   std::string first;
   for (int s = 0; s < int(plan.shots.size()); ++s) {
-    const std::optional<int> c = read_chunk(farm_folder(plan, s));
+    const std::optional<int> c = read_setting(farm_folder(plan, s), name);
     if (!c) continue;
     const std::string& path = plan.shots[std::size_t(s)].path;
-    if (chunk && *c != *chunk)
-      throw Error(Error::Field{"chunk"},
-                  fmt::format("'{}' was submitted with chunk {} and '{}' with {}: ask for them "
+    if (value && *c != *value)
+      throw Error(Error::Field{name},
+                  fmt::format("'{}' was submitted with {} {} and '{}' with {}: ask for them "
                               "one at a time",
-                              echo_path(first), *chunk, echo_path(path), *c));
-    chunk = c;
+                              echo_path(first), name, *value, echo_path(path), *c));
+    value = c;
     first = path;
   }
-  return chunk;
+  return value;
+}
+
+}  // namespace
+
+std::optional<int> submitted_chunk(const Plan& plan) {
+  return submitted_setting(plan, "chunk");
+}
+
+std::optional<int> submitted_threads(const Plan& plan) {
+  return submitted_setting(plan, "threads");
+}
+
+int status_exit_code(const std::vector<TaskStatus>& states) {
+  bool failed = false, queued = false, unsubmitted = false;
+  for (const TaskStatus& st : states) {
+    failed |= st.state == TaskState::kFailed || st.state == TaskState::kNotRun;
+    queued |= st.state == TaskState::kPending || st.state == TaskState::kRunning;
+    unsubmitted |= st.state == TaskState::kNotSubmitted;
+  }
+  return failed ? 4 : queued ? 3 : unsubmitted ? 5 : 0;
+}
+
+std::string status_json(const Plan& plan, const std::vector<TaskStatus>& states) {
+  // Logs and Slurm's reasons are any bytes: their bad UTF-8 is marked, never an error.
+  const auto text = [](const std::string& s) {
+    return s.empty() ? std::string("null") : shot::json_string(valid_utf8_or_marks(s), "status");
+  };
+  std::string out = "[\n";
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const TaskStatus& st = states[i];
+    const Task& t = *st.task;
+    out += fmt::format(
+        "  {{\"task\": {}, \"shot\": {}, \"kind\": \"{}\", \"layer\": {}, \"frames\": [{}, {}], "
+        "\"state\": \"{}\", \"job\": {}, \"exit\": {}, \"log\": {}, \"error\": {}, "
+        "\"detail\": {}}}{}\n",
+        text(t.id), text(plan.shots[std::size_t(t.shot)].name), shot::task_kind_name(t.kind),
+        text(t.layer), t.first_frame, t.last_frame, task_state_name(st.state), text(st.job),
+        st.exit_code ? std::to_string(*st.exit_code) : "null", text(st.log), text(st.error_line),
+        text(st.detail), i + 1 < states.size() ? "," : "");
+  }
+  return out + "]\n";
+}
+
+std::string slurm_failure(const std::string& tool, int exit_code, const std::string& err) {
+  if (exit_code < 0 && err.empty())
+    return fmt::format("could not run {}: Slurm's commands are not installed here (not on PATH)",
+                       tool);
+  const auto has = [&err](const char* s) { return err.find(s) != std::string::npos; };
+  if (has("configuration source") || has("slurm.conf") || has("fetch_config"))
+    return fmt::format(
+        "Slurm is not configured on this machine ({} finds no slurm.conf: set "
+        "SLURM_CONF to the cluster's)",
+        tool);
+  if (has("Unable to contact slurm controller") || has("Unable to contact slurmctld") ||
+      has("connect failure") || has("Connection refused"))
+    return fmt::format("the Slurm controller does not answer ({}: {}); is slurmctld running?", tool,
+                       first_line(err));
+  return fmt::format("{} failed ({}): {}", tool, exit_code, first_line(err));
 }
 
 int cancel(const Plan& plan) {

@@ -20,11 +20,18 @@ struct SlurmOptions {
   bool dry_run = false;                  // print the scripts; submit nothing, write nothing
 };
 
+struct SubmittedArray {
+  std::string job;   // Slurm's job id
+  std::string name;  // its job name, emaki:SHOT:STAGE
+  int tasks = 0;
+};
+
 struct Submitted {
-  std::vector<std::string> scripts;  // dry run: the scripts' text; else their paths
-  int jobs = 0;                      // job arrays submitted
-  int tasks = 0;                     // tasks in them
-  int done = 0;                      // tasks left out as finished already
+  std::vector<std::string> scripts;    // dry run: the scripts' text; else their paths
+  std::vector<SubmittedArray> arrays;  // what was queued, in submission order (none in a dry run)
+  int jobs = 0;                        // job arrays submitted
+  int tasks = 0;                       // tasks in them
+  int done = 0;                        // tasks left out as finished already
 };
 
 // Submits the plan's unfinished tasks, each array as `sbatch --chdir=OUTPUT/farm`. Throws
@@ -47,7 +54,19 @@ struct TaskStatus {
   TaskState state = TaskState::kNotSubmitted;
   std::string job;     // "JOBID_INDEX"
   std::string detail;  // a failed task's exit code, log and error line; a pending task's reason
+  std::optional<int> exit_code;  // the task's recorded exit code, when it finished
+  std::string log;               // its log, when it ran (or started)
+  std::string error_line;        // a failed task's log's error line
 };
+
+// `emaki farm status`'s exit code for these states: 0 every task done, 3 none failed and some
+// still pending or running, 4 some failed or left the queue without running, 5 none of those
+// but some never submitted.
+int status_exit_code(const std::vector<TaskStatus>& states);
+
+// The states as JSON: an array of one object per task (task, shot, kind, layer, frames, state,
+// job, exit, log, error, detail).
+std::string status_json(const shot::Plan& plan, const std::vector<TaskStatus>& states);
 
 // Every task's state, from the queue (the user's own jobs, under the shot's own job names), the
 // exit codes and the outputs on disk.
@@ -58,6 +77,12 @@ std::vector<TaskStatus> status(const shot::Plan& plan);
 // submitted. Throws emaki::Error naming a shot's record when it is not a chunk, or the field
 // "chunk" when the shots were submitted with different chunks.
 std::optional<int> submitted_chunk(const shot::Plan& plan);
+// The same for the threads per task (`--threads`), recorded in farm/threads.
+std::optional<int> submitted_threads(const shot::Plan& plan);
+
+// Slurm's command-line tool `tool` failed with `r`: one line saying why in a user's terms (Slurm
+// not installed, not configured, its controller unreachable), else the tool's first line.
+std::string slurm_failure(const std::string& tool, int exit_code, const std::string& err);
 
 // Cancels every queued job recorded for the plan's shots that is the user's and carries the
 // shot's own job name (scancel --user --name). Returns the job arrays cancelled.

@@ -245,6 +245,54 @@ TEST_F(SlurmTest, StatusAndCancelTouchOnlyTheUsersJobsUnderTheShotsNames) {
   }
 }
 
+// What a TD's script reads: submit's job ids, status as JSON and as an exit code, the settings
+// submit recorded.
+TEST_F(SlurmTest, SubmitRecordsItsArraysAndStatusReadsAsJsonAndAnExitCode) {
+  const shot::Plan p = plan_of("a.toml", (dir_ / "out").string());
+  const Submitted s = submit(p, {});
+  ASSERT_EQ(int(s.arrays.size()), s.jobs);
+  EXPECT_EQ(s.arrays[0].job, "100");
+  EXPECT_EQ(s.arrays[0].name, "emaki:" + p.shots[0].name + ":prepare");
+  EXPECT_EQ(s.arrays[0].tasks, 1);
+  EXPECT_EQ(submitted_chunk(p), p.chunk);
+  EXPECT_EQ(submitted_threads(p), p.threads);
+  // Nothing ran (the stand-in only queued them) and the queue is empty: not run.
+  std::vector<TaskStatus> st = status(p);
+  EXPECT_EQ(status_exit_code(st), 4);
+  const std::string json = status_json(p, st);
+  EXPECT_EQ(json.front(), '[');
+  EXPECT_NE(json.find("\"state\": \"not run\", \"job\": \"100_0\", \"exit\": null"),
+            std::string::npos)
+      << json;
+  for (TaskStatus& t : st) t.state = TaskState::kDone;
+  EXPECT_EQ(status_exit_code(st), 0);
+  st[1].state = TaskState::kPending;
+  EXPECT_EQ(status_exit_code(st), 3);
+  st[0].state = TaskState::kNotSubmitted;
+  EXPECT_EQ(status_exit_code(st), 3);
+  st[1].state = TaskState::kDone;
+  EXPECT_EQ(status_exit_code(st), 5);
+  st[1].state = TaskState::kFailed;
+  EXPECT_EQ(status_exit_code(st), 4);
+}
+
+TEST(SlurmFailure, SaysWhatIsMissingInOneLine) {
+  EXPECT_NE(slurm_failure("squeue", -1, "").find("not installed"), std::string::npos);
+  const std::string no_conf = slurm_failure(
+      "squeue", 1,
+      "squeue: error: resolve_ctls_from_dns_srv: res_nsearch error: Unknown host\nsqueue: "
+      "error: fetch_config: DNS SRV lookup failed\nsqueue: fatal: Could not establish a "
+      "configuration source\n");
+  EXPECT_NE(no_conf.find("not configured"), std::string::npos) << no_conf;
+  EXPECT_EQ(no_conf.find('\n'), std::string::npos);
+  const std::string down = slurm_failure(
+      "squeue", 1, "slurm_load_jobs error: Unable to contact slurm controller (connect failure)\n");
+  EXPECT_NE(down.find("controller does not answer"), std::string::npos) << down;
+  EXPECT_EQ(down.find('\n'), std::string::npos);
+  EXPECT_EQ(slurm_failure("sbatch", 1, "sbatch: error: Invalid partition\nmore\n"),
+            "sbatch failed (1): sbatch: error: Invalid partition");
+}
+
 // The records of an array must be on disk before the next array is queued: a write that fails
 // (here past RLIMIT_FSIZE, as on a full disk) cancels that array and stops the submission.
 TEST_F(SlurmTest, AJobsRecordThatCannotBeWrittenStopsTheSubmission) {

@@ -45,7 +45,12 @@ float AnyImage::value(int x, int y, int c) const {
   return std::visit([&](const auto& im) { return normalised(im(x, y, c)); }, image);
 }
 
-Image<float> AnyImage::to_float() const {
+Image<float> AnyImage::to_float() && {
+  if (auto* f = std::get_if<Image<float>>(&image)) return std::move(*f);
+  return static_cast<const AnyImage&>(*this).to_float();
+}
+
+Image<float> AnyImage::to_float() const& {
   return std::visit(
       [](const auto& im) {
         Image<float> out(im.width(), im.height(), im.channels());
@@ -240,17 +245,90 @@ std::vector<std::string> list_channels(const std::string& path) {
   return names;
 }
 
-AnyImage read_image(const std::string& path, const ReadOptions& options) {
-  check_readable(path);
-  if (is_png(path) || lower_ext(path) == ".png")
-    return pick_png_channels(detail::read_png(path), path, options);
-  check_exr_file(path);
+namespace {
+
+using File = std::unique_ptr<std::FILE, detail::FileCloser>;
+
+File open_for_reading(const std::string& path) {
+  File f(std::fopen(path.c_str(), "rb"));
+  if (!f) throw Error(path, "cannot open for reading");
+  return f;
+}
+
+void rewind_or_throw(std::FILE* f, const std::string& path) {
+  if (std::fseek(f, 0, SEEK_SET) != 0) throw Error(path, "cannot read the file");
+}
+
+// The image in the open file `f` (at its start): the format told by its first bytes, the
+// header walked first for an EXR (`whole`: and its chunk tables to the end of the file).
+AnyImage read_open_file(std::FILE* f, const std::string& path, const ReadOptions& options,
+                        bool whole) {
+  unsigned char magic[8] = {};
+  const std::size_t n = std::fread(magic, 1, sizeof magic, f);
+  rewind_or_throw(f, path);
+  if (has_png_signature(magic, n) || lower_ext(path) == ".png")
+    return pick_png_channels(detail::read_png(f, path), path, options);
+  const bool exr = detail::has_exr_magic(magic, n);
+  if (exr || lower_ext(path) == ".exr") {
+    if (whole)
+      detail::check_exr_complete(f, path);
+    else
+      detail::check_exr_header(f, path);
+    rewind_or_throw(f, path);
+  }
   AnyImage result;
+  // OpenEXR reads through the open file; the other formats' readers open the path themselves.
+  detail::OiioSource source{path};
+  if (lower_ext(path) == ".exr") source.file = f;
   std::lock_guard lock(detail::oiio_mutex());
-  if (std::string e = detail::oiio_backend(path).read({path}, options, max_pixels(), result);
+  if (std::string e = detail::oiio_backend(path).read(source, options, max_pixels(), result);
       !e.empty())
     throw Error(path, e);
   return result;
+}
+
+}  // namespace
+
+// One open of the file for everything: telling its format, walking its header, decoding.
+AnyImage read_image(const std::string& path, const ReadOptions& options) {
+  check_readable(path);
+  const File f = open_for_reading(path);
+  return read_open_file(f.get(), path, options, false);
+}
+
+std::optional<AnyImage> read_image_if_complete(const std::string& path,
+                                               const ReadOptions& options) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) == 0 || ec) return std::nullopt;
+  const std::string ext = lower_ext(path);
+  if (ext != ".exr") {
+    if (!image_file_complete(path)) return std::nullopt;
+    return read_image(path, options);
+  }
+  File f(std::fopen(path.c_str(), "rb"));
+  if (!f) return std::nullopt;
+  try {
+    detail::check_exr_complete(f.get(), path);
+  } catch (const Error&) {
+    return std::nullopt;
+  }
+  rewind_or_throw(f.get(), path);
+  return read_open_file(f.get(), path, options, false);
+}
+
+std::vector<std::string> list_channels_memory(const void* data, std::size_t size,
+                                              const std::string& name) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  if (has_png_signature(bytes, size) || lower_ext(name) == ".png")
+    return detail::read_png_memory(data, size, name).channel_names;  // decoded: PNGs are small
+  if (lower_ext(name) == ".exr" || detail::has_exr_magic(bytes, size))
+    detail::check_exr_header(bytes, size, name);
+  std::vector<std::string> names;
+  std::lock_guard lock(detail::oiio_mutex());
+  if (std::string e = detail::oiio_backend(name).list_channels({name, data, size}, names);
+      !e.empty())
+    throw Error(name, e);
+  return names;
 }
 
 AnyImage read_image_memory(const void* data, std::size_t size, const std::string& name,
@@ -364,8 +442,8 @@ void write_image(const std::string& path, ImageView<const float> image,
   }
   {
     std::lock_guard lock(detail::oiio_mutex());
-    if (std::string e =
-            detail::oiio_backend(path).write(tmp.path(), image, options.channel_names, type);
+    if (std::string e = detail::oiio_backend(path).write(tmp.path(), image, options.channel_names,
+                                                         type, options.compression);
         !e.empty())
       throw Error(path, e);
   }

@@ -12,7 +12,9 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -176,6 +178,45 @@ TEST_F(ImageIo, APluginThatCannotLoadIsTheErrorNotAFallBack) {
         std::exit(code);
       },
       ::testing::ExitedWithCode(3), "cannot load the OpenImageIO plugin .*libemaki_io_oiio.so");
+}
+
+// Named channels are read from one decoding of their part, a band of rows at a time: every
+// compression, an image taller than a band and not a whole number of them, channels asked for
+// in another order than the file's, a cheap intermediate compression.
+TEST_F(ImageIo, NamedChannelsOfATallImageReadExactlyInAnyOrder) {
+  const Image<float> im = ramp(23, 150, 5, 977);
+  const std::vector<std::string> names = {"a.X", "b.Y", "c", "d.Z", "e"};
+  for (const char* compression : {"zip", "none", "rle", "zips", "piz"}) {
+    SCOPED_TRACE(compression);
+    WriteOptions o;
+    o.format = SampleFormat::kFloat;
+    o.channel_names = names;
+    o.compression = compression;
+    write_image(p("t.exr"), im.cview(), o);
+    const Image<float> back = read_image_float(p("t.exr"), ReadOptions{{"e", "b.Y", "a.X", "d.Z"}});
+    ASSERT_EQ(back.channels(), 4);
+    const int from[4] = {4, 1, 0, 3};
+    for (int y = 0; y < im.height(); ++y)
+      for (int x = 0; x < im.width(); ++x)
+        for (int k = 0; k < 4; ++k) ASSERT_EQ(back(x, y, k), im(x, y, from[k])) << x << "," << y;
+  }
+}
+
+// The pass cache's read: a whole file is read (in one open), one cut short or missing is not.
+TEST_F(ImageIo, ReadIfCompleteReadsWholeFilesOnly) {
+  const Image<float> im = ramp(17, 70, 3, 101);
+  WriteOptions o;
+  o.format = SampleFormat::kFloat;
+  write_image(p("w.exr"), im.cview(), o);
+  const std::optional<AnyImage> whole = read_image_if_complete(p("w.exr"));
+  ASSERT_TRUE(whole.has_value());
+  EXPECT_EQ(whole->value(3, 60, 2), im(3, 60, 2));
+  EXPECT_FALSE(read_image_if_complete(p("none.exr")).has_value());
+  std::ifstream in(p("w.exr"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  std::ofstream(p("cut.exr"), std::ios::binary)
+      .write(bytes.data(), std::streamsize(bytes.size() - 5));
+  EXPECT_FALSE(read_image_if_complete(p("cut.exr")).has_value());
 }
 
 TEST_F(ImageIo, HalfExrKeepsHalfPrecision) {

@@ -12,6 +12,8 @@
 #include <memory>
 #include <new>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -33,7 +35,7 @@ std::string first_line(std::string e, const std::string& fallback) {
 // The opened file. OpenImageIO keeps a pointer to the memory proxy, so the proxy lives beside
 // the input and outlives it (members are destroyed in reverse order).
 struct Opened {
-  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
+  std::unique_ptr<OIIO::Filesystem::IOProxy> proxy;
   std::unique_ptr<ImageInput> in;
 };
 
@@ -54,11 +56,21 @@ std::string open_source(const OiioSource& source, Opened& o) {
   if (!format) return "unsupported image format (emaki reads .png, .exr, .tif and .jpg files)";
   if (source.data)
     o.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(source.data, source.size);
+  else if (source.file)
+    o.proxy =
+        std::make_unique<OIIO::Filesystem::IOFile>(source.file, OIIO::Filesystem::IOProxy::Read);
   o.in = ImageInput::create(format, false, nullptr, o.proxy.get());
   if (!o.in)
     return "cannot read image (" + first_line(OIIO::geterror(), "no reader for the format") + ")";
   ImageSpec spec;
-  if (!o.in->open(source.path, spec))
+  // The reader takes the proxy from the configuration (set on the input alone, OpenEXR's reader
+  // opens the path again).
+  ImageSpec config;
+  if (o.proxy) {
+    void* proxy = o.proxy.get();
+    config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
+  }
+  if (!o.in->open(source.path, spec, config))
     return "cannot read image (" + first_line(o.in->geterror(), "not a valid file") + ")";
   return {};
 }
@@ -165,6 +177,45 @@ std::string read_whole(ImageInput& in, const ImageSpec& spec, TypeDesc type, Any
   return {};
 }
 
+// Reads the channels `picks` (file channel -> channel of `out`) of part `sub` (the current one)
+// from one pass over its pixels. Scanline files are read a band of rows at a time, the span of
+// the picked channels into a small buffer, so memory stays the output's; a tiled part reads one
+// channel at a time (studio renders are scanline files).
+std::string read_part_channels(ImageInput& in, int sub,
+                               const std::vector<std::pair<int, int>>& picks, Image<float>& out) {
+  const ImageSpec& spec = in.spec();
+  const auto failed = [&in] {
+    return "corrupt or truncated image (" + first_line(in.geterror(), "read failed") + ")";
+  };
+  if (spec.tile_width != 0) {
+    for (const auto& [ch, dst] : picks)
+      if (!read_into(in, sub, ch, ch + 1, out, dst, TypeDesc::FLOAT)) return failed();
+    return {};
+  }
+  int first = spec.nchannels, last = -1;
+  for (const auto& [ch, dst] : picks) first = std::min(first, ch), last = std::max(last, ch);
+  const int span = last - first + 1;
+  // 64 rows: a whole number of OpenEXR's blocks (1, 16 or 32 rows) in every compression.
+  constexpr int kBand = 64;
+  const int w = spec.width;
+  std::vector<float> band(std::size_t(w) * std::size_t(std::min(kBand, spec.height)) *
+                          std::size_t(span));
+  for (int y0 = 0; y0 < spec.height; y0 += kBand) {
+    const int y1 = std::min(spec.height, y0 + kBand);
+    if (!in.read_scanlines(sub, 0, spec.y + y0, spec.y + y1, 0, first, last + 1, TypeDesc::FLOAT,
+                           band.data()))
+      return failed();
+    for (int y = y0; y < y1; ++y) {
+      const float* row = band.data() + std::size_t(y - y0) * std::size_t(w) * std::size_t(span);
+      float* o = out.row(y);
+      for (const auto& [ch, dst] : picks)
+        for (int x = 0; x < w; ++x)
+          o[std::ptrdiff_t(x) * out.channels() + dst] = row[std::ptrdiff_t(x) * span + ch - first];
+    }
+  }
+  return {};
+}
+
 std::string read_checked(const OiioSource& source, const ReadOptions& options, AnyImage& result) {
   Opened o;
   if (std::string e = open_source(source, o); !e.empty()) return e;
@@ -214,10 +265,19 @@ std::string read_checked(const OiioSource& source, const ReadOptions& options, A
   }
   check_image_alloc<float>("", width, height, int64_t(where.size()));
   Image<float> im = allocate_image<float>("", width, height, int(where.size()));
-  for (std::size_t i = 0; i < where.size(); ++i) {
-    if (!in.seek_subimage(where[i].sub, 0) ||
-        !read_into(in, where[i].sub, where[i].ch, where[i].ch + 1, im, int(i), TypeDesc::FLOAT))
+  // Each part is decoded once: a compressed file is decompressed whole however few of its
+  // channels are asked for, so one channel at a time would decode it once per channel (24 times
+  // for a frame of passes).
+  std::vector<int> parts;
+  for (const Where& w : where)
+    if (std::find(parts.begin(), parts.end(), w.sub) == parts.end()) parts.push_back(w.sub);
+  for (const int sub : parts) {
+    if (!in.seek_subimage(sub, 0))
       return "corrupt or truncated image (" + first_line(in.geterror(), "read failed") + ")";
+    std::vector<std::pair<int, int>> picks;  // the part's channel -> the image's
+    for (std::size_t i = 0; i < where.size(); ++i)
+      if (where[i].sub == sub) picks.emplace_back(where[i].ch, int(i));
+    if (std::string e = read_part_channels(in, sub, picks, im); !e.empty()) return e;
   }
   if (std::string e = check_finite(im); !e.empty()) return e;
   result.image = std::move(im);
@@ -253,14 +313,15 @@ std::string list_impl(const OiioSource& source, std::vector<std::string>& names)
 }
 
 std::string write_impl(const std::string& path, ImageView<const float> image,
-                       const std::vector<std::string>& names, int type_code) {
+                       const std::vector<std::string>& names, int type_code,
+                       const std::string& compression) {
   static const TypeDesc kTypes[4] = {TypeDesc::UINT8, TypeDesc::UINT16, TypeDesc::HALF,
                                      TypeDesc::FLOAT};
   ImageSpec spec(image.width, image.height, image.channels, kTypes[type_code]);
   if (!names.empty()) spec.channelnames = names;
   if (names.empty() && (image.channels == 4 || image.channels == 2))
     spec.alpha_channel = image.channels - 1;
-  spec.attribute("compression", "zip");
+  spec.attribute("compression", compression);
   // OpenImageIO stamps EXRs with the time of writing (capDate) unless told a date: a fixed one
   // makes the same image the same file, so runs (and farm tasks) can be compared byte for byte.
   spec.attribute("DateTime", "2000:01:01 00:00:00");

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -13,12 +14,14 @@
 
 namespace emaki::io::detail {
 
-// Where a read comes from: the file `path`, or, when `data` is set, `size` bytes in memory
-// (then `path` is only a name whose extension picks the format).
+// Where a read comes from: the file `path`, or, when `data` is set, `size` bytes in memory, or,
+// when `file` is set, that file already open (the caller's, read from its start and left open):
+// then `path` is only a name whose extension picks the format.
 struct OiioSource {
   std::string path;
   const void* data = nullptr;
   std::size_t size = 0;
+  std::FILE* file = nullptr;
 };
 
 struct OiioBackend {
@@ -28,9 +31,11 @@ struct OiioBackend {
   std::string (*read)(const OiioSource& source, const ReadOptions& options, int64_t max_pixels,
                       AnyImage& out);
   std::string (*list_channels)(const OiioSource& source, std::vector<std::string>& out);
-  // Writes to `path` exactly (the caller makes it atomic). `type`: 0 u8, 1 u16, 2 half, 3 float.
+  // Writes to `path` exactly (the caller makes it atomic). `type`: 0 u8, 1 u16, 2 half, 3 float;
+  // `compression`: an EXR's ("zip", "none", ...).
   std::string (*write)(const std::string& path, ImageView<const float> image,
-                       const std::vector<std::string>& channel_names, int type);
+                       const std::vector<std::string>& channel_names, int type,
+                       const std::string& compression);
 };
 
 // Loads the module (once); throws emaki::Error naming `subject` if it cannot.

@@ -214,6 +214,12 @@ AnyImage read_png(const std::string& path) {
   return decode(src, path, false);
 }
 
+AnyImage read_png(std::FILE* file, const std::string& name) {
+  PngSource src;
+  src.file = file;
+  return decode(src, name, false);
+}
+
 AnyImage read_png_header(const std::string& path) {
   std::unique_ptr<FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
   if (!file) throw Error(path, "cannot open for reading");

@@ -25,6 +25,9 @@ struct FileCloser {
 // The size in the header is checked against the pixel budget (core/limits.h) before any pixel
 // memory is allocated. Errors throw emaki::Error naming `path` (or `name`).
 AnyImage read_png(const std::string& path);
+// The same from a file the caller opened (read from its current position, left open); `name` is
+// the error subject.
+AnyImage read_png(std::FILE* file, const std::string& name);
 // The same from bytes in memory; `name` is the error subject.
 AnyImage read_png_memory(const void* data, std::size_t size, const std::string& name);
 // Only the header: channel names (R, G, B, A / Y, A) with an empty image.

@@ -50,10 +50,12 @@ void check_peak_memory(const pipeline::Shot& shot, const Request& r, const char*
 
 // The exemplars, loaded between two memory checks: the frames' share alone first, so a shot far
 // too large is refused before its paintings are read, then with the paintings.
+// `rendered`: as load_exemplars takes it.
 Exemplars load_exemplars_checked(const pipeline::Shot& shot, const Request& r, const char* work,
-                                 std::initializer_list<TaskKind> kinds) {
+                                 std::initializer_list<TaskKind> kinds,
+                                 std::vector<std::string>* rendered = nullptr) {
   check_peak_memory(shot, r, work, kinds);
-  Exemplars exemplars = load_exemplars(shot);
+  Exemplars exemplars = load_exemplars(shot, rendered);
   check_peak_memory(shot, r, work, kinds, exemplars);
   return exemplars;
 }
@@ -81,15 +83,18 @@ RunResult run(const pipeline::Shot& shot, const Request& request) {
   pipeline::check_run_options(shot, run_options(request));
   const Scope scope(shot, request);
   // Everything that can fail on the inputs fails here, before a single output file exists.
+  std::vector<std::string> rendered;
   const auto exemplars = load_exemplars_checked(
       shot, request, request.composite ? "the run" : "the layer task",
       {TaskKind::kLayer, request.composite ? TaskKind::kComposite : TaskKind::kLayer,
-       TaskKind::kPasses});
+       TaskKind::kPasses},
+      &rendered);
   const auto frames = open_frames(shot);
   const pipeline::CompositeInputs ci = load_composite_inputs(shot);
   const pipeline::WeightMapImages maps = load_weight_maps(shot);
   RunResult out;
   io::FileStore store(shot, io::StoreMode::kRun, access(request));  // locked until the end
+  keep_references(shot, exemplars, rendered);
   out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request), maps);
   out.previews = previews(shot, request);
   return out;
@@ -112,12 +117,16 @@ CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
 void prepare(const pipeline::Shot& shot, const Request& request) {
   const Scope scope(shot, request);
   // Everything that can fail on the inputs fails here, before a single task writes a file.
-  (void)load_exemplars_checked(shot, request, "the prepare task", {TaskKind::kPrepare});
+  std::vector<std::string> rendered;
+  const Exemplars exemplars =
+      load_exemplars_checked(shot, request, "the prepare task", {TaskKind::kPrepare}, &rendered);
   (void)open_frames(shot);
   (void)load_composite_inputs(shot);
   (void)load_weight_maps(shot);
   io::FileStore store(shot);
   store.prepare();
+  // The layer tasks read the exemplars' reference passes from here instead of rendering them.
+  keep_references(shot, exemplars, rendered);
 }
 
 int render_passes(const pipeline::Shot& shot, const Request& request) {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -12,6 +13,8 @@
 #include "shot/objects.h"
 #include "store/file_store.h"
 #include "store/frame_sequence.h"
+#include "store/output_store.h"
+#include "store/reference_cache.h"
 
 namespace emaki::shot {
 
@@ -32,8 +35,24 @@ namespace {
   throw e.respelled(e.subject());
 }
 
+// The largest input file read whole into memory to be decoded (and digested) in one read; a
+// larger one is read the ordinary way.
+constexpr std::size_t kMaxInputBytes = std::size_t(1) << 30;
+
+// An input file's bytes, read once for its decoding and its digest (file_digest); empty when it
+// is left to the readers that take a path (which word the errors).
+std::optional<std::string> input_bytes(const std::string& path) {
+  return io::read_input_file(path, kMaxInputBytes);
+}
+
+Image<float> read_input_image(const std::string& path, const ReadOptions& options = {}) {
+  if (const std::optional<std::string> bytes = input_bytes(path))
+    return io::read_image_memory(bytes->data(), bytes->size(), path, options).to_float();
+  return io::read_image_float(path, options);
+}
+
 Image<float> rgb_of(const std::string& key, const std::string& path) {
-  Image<float> img = io::read_image_float(path);
+  Image<float> img = read_input_image(path);
   if (img.channels() >= 3 && img.channels() <= 4) {
     if (img.channels() == 3) return img;
     Image<float> out(img.width(), img.height(), 3);
@@ -65,7 +84,8 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
   }
 }
 
-std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot) {
+std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
+                                                               std::vector<std::string>* rendered) {
   std::map<std::string, pipeline::ExemplarImages> out;
   for (const pipeline::Exemplar& e : shot.exemplars) {
     const std::string key = "exemplars." + e.name;
@@ -73,46 +93,82 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot)
     im.painting = rgb_of(key + ".painting", e.painting);
     const int w = im.painting.width(), h = im.painting.height();
     if (e.kind == pipeline::ExemplarKind::kMatcap) {
-      try {
-        im.passes = pipeline::matcap_passes(e, w, h);
-      } catch (const Error& err) {
-        rethrow_as_key(err, key);
+      // Rendered once per shot: later tasks and runs read what the first one kept.
+      std::optional<Image<float>> kept;
+      if (rendered)
+        kept = io::read_reference(shot.outputs.folder, io::reference_key(e, w, h), w, h);
+      if (kept) {
+        im.passes = std::move(*kept);
+      } else {
+        try {
+          im.passes = pipeline::matcap_passes(e, w, h);
+        } catch (const Error& err) {
+          rethrow_as_key(err, key);
+        }
+        if (rendered) rendered->push_back(e.name);
       }
     } else {
-      // Read the passes the layers use as guides; the rest stay zero.
+      // The passes the layers use as guides, read in one go; the rest stay zero.
       im.passes = Image<float>(w, h, render::kChannelCount);
-      const std::vector<std::string> have = io::list_channels(e.passes);
+      const std::optional<std::string> bytes = input_bytes(e.passes);
+      const std::vector<std::string> have =
+          bytes ? io::list_channels_memory(bytes->data(), bytes->size(), e.passes)
+                : io::list_channels(e.passes);
+      std::vector<std::string> names;  // the file's channels to read
+      std::vector<int> into;           // parallel: the channel of im.passes each fills
       for (const pipeline::Layer& l : shot.layers) {
         if (l.exemplar != e.name) continue;
         for (const pipeline::GuideSpec& g : l.guides) {
           const render::PassInfo* p = render::find_pass(g.pass);
-          std::vector<std::string> names;
+          std::vector<std::string> pass_names;
           for (int c = 0; c < p->count; ++c)
-            names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
+            pass_names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
           // tools/blender/emaki_passes.py writes a single-channel pass as NAME.V.
           const std::string value = std::string(p->name) + ".V";
-          if (p->count == 1 && std::find(have.begin(), have.end(), names[0]) == have.end() &&
+          if (p->count == 1 && std::find(have.begin(), have.end(), pass_names[0]) == have.end() &&
               std::find(have.begin(), have.end(), value) != have.end())
-            names = {value};
-          for (const std::string& n : names)
+            pass_names = {value};
+          for (int c = 0; c < p->count; ++c) {
+            const std::string& n = pass_names[std::size_t(c)];
             if (std::find(have.begin(), have.end(), n) == have.end())
               throw Error(key + ".passes",
                           fmt::format("channel '{}' (guide '{}' of layer '{}') is not in '{}'", n,
                                       g.pass, l.name, e.passes));
-          const Image<float> pass = io::read_image_float(e.passes, ReadOptions{names});
-          if (pass.width() != w || pass.height() != h)
-            throw Error(key + ".passes",
-                        fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}", e.passes,
-                                    pass.width(), pass.height(), e.painting, w, h));
-          for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x)
-              for (int c = 0; c < p->count; ++c) im.passes(x, y, p->first + c) = pass(x, y, c);
+            if (std::find(into.begin(), into.end(), p->first + c) != into.end()) continue;
+            names.push_back(n);
+            into.push_back(p->first + c);
+          }
         }
+      }
+      if (!names.empty()) {
+        const Image<float> pass = bytes ? io::read_image_memory(bytes->data(), bytes->size(),
+                                                                e.passes, ReadOptions{names})
+                                              .to_float()
+                                        : io::read_image_float(e.passes, ReadOptions{names});
+        if (pass.width() != w || pass.height() != h)
+          throw Error(key + ".passes",
+                      fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}", e.passes,
+                                  pass.width(), pass.height(), e.painting, w, h));
+        for (int y = 0; y < h; ++y)
+          for (int x = 0; x < w; ++x)
+            for (std::size_t i = 0; i < into.size(); ++i)
+              im.passes(x, y, into[i]) = pass(x, y, int(i));
       }
     }
     out.emplace(e.name, std::move(im));
   }
   return out;
+}
+
+void keep_references(const Shot& shot,
+                     const std::map<std::string, pipeline::ExemplarImages>& exemplars,
+                     const std::vector<std::string>& rendered) {
+  for (const std::string& name : rendered) {
+    const pipeline::ExemplarImages& im = exemplars.at(name);
+    const int w = im.painting.width(), h = im.painting.height();
+    io::write_reference(shot.outputs.folder, io::reference_key(*shot.find_exemplar(name), w, h),
+                        im.passes.cview());
+  }
 }
 
 pipeline::WeightMapImages load_weight_maps(const Shot& shot) {

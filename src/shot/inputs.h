@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
@@ -15,8 +16,17 @@ namespace emaki::shot {
 
 std::unique_ptr<pipeline::FrameSource> open_frames(const pipeline::Shot& shot);
 
-// Every exemplar's painting and guide passes; errors name exemplars.NAME.*.
-std::map<std::string, pipeline::ExemplarImages> load_exemplars(const pipeline::Shot& shot);
+// Every exemplar's painting and guide passes; errors name exemplars.NAME.*. With `rendered`, a
+// MatCap-like exemplar's reference passes are read from the shot's output folder when a task or
+// run kept them there (store/reference_cache.h), and the exemplars whose passes had to be
+// rendered are added to it, for keep_references once the output folder is locked.
+std::map<std::string, pipeline::ExemplarImages> load_exemplars(
+    const pipeline::Shot& shot, std::vector<std::string>* rendered = nullptr);
+
+// Keeps the `rendered` exemplars' reference passes in the shot's output folder.
+void keep_references(const pipeline::Shot& shot,
+                     const std::map<std::string, pipeline::ExemplarImages>& exemplars,
+                     const std::vector<std::string>& rendered);
 
 pipeline::CompositeInputs load_composite_inputs(const pipeline::Shot& shot);
 

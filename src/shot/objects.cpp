@@ -6,8 +6,10 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -15,10 +17,22 @@
 #include "core/limits.h"
 #include "io/gltf_loader.h"
 #include "scene/assembly.h"
+#include "store/output_store.h"
 
 namespace emaki::shot {
 
 namespace {
+
+// A scene file read once: its bytes parsed, and digested for the manifests (file_digest). A file
+// that cannot be read whole is left to load_gltf, which words the error.
+scene::Scene read_scene(const std::string& path) {
+  if (const std::optional<std::string> bytes =
+          io::read_input_file(path, std::size_t(io::kMaxFileBytes))) {
+    const std::string dir = std::filesystem::path(path).parent_path().string();
+    return io::load_gltf_from_memory(*bytes, path, dir.empty() ? "." : dir);
+  }
+  return io::load_gltf(path);
+}
 
 std::string key_of(std::size_t i, const char* key) {
   return fmt::format("source.objects[{}].{}", i, key);
@@ -112,7 +126,7 @@ scene::Scene load_objects(const pipeline::Source& s, SceneCost* cost, int64_t bu
     std::unique_ptr<scene::Scene>& asset = assets[file_identity(o.scene, key)];
     if (!asset) {
       try {
-        asset = std::make_unique<scene::Scene>(io::load_gltf(o.scene));
+        asset = std::make_unique<scene::Scene>(read_scene(o.scene));
       } catch (const Error& e) {
         throw Error(key, e.what());
       }
@@ -148,7 +162,7 @@ scene::Scene load_objects(const pipeline::Source& s, SceneCost* cost, int64_t bu
 
 scene::Scene load_scene(const pipeline::Source& s, SceneCost* cost) {
   if (!s.objects.empty()) return load_objects(s, cost);
-  scene::Scene out = io::load_gltf(s.scene_path);
+  scene::Scene out = read_scene(s.scene_path);
   SceneCost c = placement_cost(out);
   c.bytes = scene::scene_bytes(out).total();
   check_budget(c.bytes, kMaxSceneBytes, "source.scene", "the scene holds");

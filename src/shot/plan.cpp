@@ -269,6 +269,7 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options) {
                 fmt::format("must be in [1, 1024], got {}", options.threads));
   Plan p;
   p.chunk = options.chunk;
+  p.threads = options.threads;
   std::map<std::string, std::string> names;  // name -> shot file
   std::map<std::string, std::string> folders;
   for (PlannedShot& s : shots) {
@@ -296,10 +297,6 @@ Plan plan(const std::vector<std::string>& shot_paths, const PlanOptions& options
   return plan(std::move(shots), options);
 }
 
-namespace {
-
-// A JSON string. JSON is Unicode text: a value that is not UTF-8 (a path's raw bytes) cannot be
-// carried faithfully, so it is an error naming `subject` and showing the text up to the bad byte.
 std::string json_string(const std::string& s, const std::string& subject) {
   if (const std::size_t bad = first_invalid_utf8(s); bad != std::string::npos)
     throw Error(subject, fmt::format("'{}...' is not UTF-8 text (byte {} is 0x{:02x}); plan "
@@ -327,6 +324,8 @@ std::string json_string(const std::string& s, const std::string& subject) {
   }
   return out + "\"";
 }
+
+namespace {
 
 std::string json_strings(const std::vector<std::string>& v, const std::string& subject) {
   std::string out = "[";

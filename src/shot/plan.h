@@ -47,6 +47,7 @@ struct Plan {
   std::vector<PlannedShot> shots;
   std::vector<Task> tasks;  // in an order that respects `after`
   int chunk = 8;            // the options' chunk: task ids depend on it
+  int threads = 1;          // the options' threads per task
 };
 
 struct PlanOptions {
@@ -69,5 +70,9 @@ Plan plan(std::vector<PlannedShot> shots, const PlanOptions& options);
 
 // The plan as JSON (docs/farm.md).
 std::string plan_json(const Plan& plan);
+
+// A JSON string. JSON is Unicode text: a value that is not UTF-8 (a path's raw bytes) cannot be
+// carried faithfully, so it is an error naming `subject` and showing the text up to the bad byte.
+std::string json_string(const std::string& s, const std::string& subject);
 
 }  // namespace emaki::shot

@@ -181,6 +181,9 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
     });
   }
   passes_ = manifested(cache.string(), passes_manifest(shot), "frame_", {".exr"});
+  if (const fs::path refs = root / "references"; fs::is_directory(refs, ec))
+    clean_up(refs,
+             [](const std::string& t) { return t.ends_with(".exr") || t.ends_with(".digest"); });
 }
 
 void FileStore::make_current(Manifested& m, const std::string& folder,
@@ -238,6 +241,7 @@ void FileStore::write_passes(int frame, ImageView<const float> passes) {
   WriteOptions exr;
   exr.format = SampleFormat::kFloat;  // bit for bit: every task reads the same floats
   exr.channel_names = render::channel_names();
+  exr.compression = kIntermediateCompression;
   write_image(paths_.passes_exr(frame), passes, exr);
 }
 
@@ -413,12 +417,15 @@ class CachedFrames : public pipeline::FrameSource {
         inner_(std::move(inner)) {}
   // A cached frame that is missing, cut short or unreadable is rendered instead (the cache holds
   // exactly what rendering gives): a damaged cache never stops a run, `--force` or not.
+  // The file is opened once: checked whole and decoded through the same open.
   Image<float> passes(int frame) const override {
     const std::string file = paths_.passes_exr(frame);
-    if (!image_file_complete(file)) return inner_->passes(frame);
     Image<float> img;
     try {
-      img = read_image_float(file, ReadOptions{render::channel_names()});
+      std::optional<AnyImage> read =
+          read_image_if_complete(file, ReadOptions{render::channel_names()});
+      if (!read) return inner_->passes(frame);
+      img = std::move(*read).to_float();
     } catch (const Error&) {
       return inner_->passes(frame);
     }

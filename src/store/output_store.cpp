@@ -12,6 +12,8 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -121,24 +123,110 @@ std::string manifest_difference(const Manifest& have, const Manifest& want) {
   return {};
 }
 
-std::string file_digest(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return "missing";
-  // FNV-1a: fast enough for paintings and pass files, and only compared with itself (not a
-  // security boundary: a changed file is redone, a forged one is the user's own).
+namespace {
+
+// FNV-1a: fast enough for paintings and pass files, and only compared with itself (not a
+// security boundary: a changed file is redone, a forged one is the user's own).
+struct Digest {
   uint64_t h = 1469598103934665603ull;
-  std::vector<char> buf(1 << 20);
   uint64_t total = 0;
-  while (f) {
-    f.read(buf.data(), std::streamsize(buf.size()));
-    const std::size_t n = std::size_t(f.gcount());
+  void add(const char* p, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) {
-      h ^= static_cast<unsigned char>(buf[i]);
+      h ^= static_cast<unsigned char>(p[i]);
       h *= 1099511628211ull;
     }
     total += n;
   }
-  return fmt::format("{:016x}-{}", h, total);
+  std::string text() const { return fmt::format("{:016x}-{}", h, total); }
+};
+
+// A file's identity: what changes when its bytes do.
+struct FileId {
+  std::string path;
+  dev_t dev;
+  ino_t ino;
+  off_t size;
+  int64_t mtime_ns;
+  auto operator<=>(const FileId&) const = default;
+};
+
+FileId id_of(const std::string& path, const struct stat& st) {
+  return {path, st.st_dev, st.st_ino, st.st_size,
+          int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec};
+}
+
+std::mutex& digests_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::map<FileId, std::string>& digests() {
+  static std::map<FileId, std::string> d;
+  return d;
+}
+
+struct Fd {
+  int fd;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Reads the whole of `fd` (at most `cap` bytes; nullopt past it or on an error).
+std::optional<std::string> read_all(int fd, std::size_t cap) {
+  std::string out;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return std::nullopt;
+    if (n == 0) return out;
+    if (out.size() + std::size_t(n) > cap) return std::nullopt;
+    out.append(buf, std::size_t(n));
+  }
+}
+
+}  // namespace
+
+std::string file_digest(const std::string& path) {
+  struct stat st {};
+  // A file already digested is not opened again: its identity is looked up first.
+  if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+    const std::lock_guard lock(digests_mutex());
+    if (const auto it = digests().find(id_of(path, st)); it != digests().end()) return it->second;
+  }
+  const Fd f{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
+  if (f.fd < 0 || ::fstat(f.fd, &st) != 0) return "missing";
+  const FileId id = id_of(path, st);
+  Digest d;
+  std::vector<char> buf(1 << 20);
+  for (;;) {
+    const ssize_t n = ::read(f.fd, buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    d.add(buf.data(), std::size_t(n));
+  }
+  const std::string text = d.text();
+  // Only a regular file's digest is kept: a FIFO or device has no identity to tell a change by.
+  if (S_ISREG(st.st_mode)) {
+    const std::lock_guard lock(digests_mutex());
+    digests()[id] = text;
+  }
+  return text;
+}
+
+std::optional<std::string> read_input_file(const std::string& path, std::size_t cap) {
+  struct stat st {};
+  const Fd f{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
+  if (f.fd < 0 || ::fstat(f.fd, &st) != 0 || !S_ISREG(st.st_mode) || uint64_t(st.st_size) > cap)
+    return std::nullopt;
+  std::optional<std::string> bytes = read_all(f.fd, cap);
+  // A file that changed size while it was read is read again the ordinary way.
+  if (!bytes || bytes->size() != std::size_t(st.st_size)) return std::nullopt;
+  Digest d;
+  d.add(bytes->data(), bytes->size());
+  const std::lock_guard lock(digests_mutex());
+  digests()[id_of(path, st)] = d.text();
+  return bytes;
 }
 
 }  // namespace emaki::io

@@ -3,6 +3,7 @@
 // stale files. Files are written through temporaries (io/temp_file.h).
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,7 +40,16 @@ void write_manifest(const std::string& path, const Manifest& m);
 // The first line of `want` that `have` lacks or changes, as "key: was X, now Y"; empty when equal.
 std::string manifest_difference(const Manifest& have, const Manifest& want);
 
-// A 64-bit digest of a file's bytes as 16 hex digits; "missing" when it cannot be read.
+// A 64-bit digest of a file's bytes as 16 hex digits and its size; "missing" when it cannot be
+// read. A process reads each file for it once: the digest is remembered under the file's
+// identity (device, inode, size, modification time), so the manifests of a shot's layers, which
+// all name its paintings, cost one read of each.
 std::string file_digest(const std::string& path);
+
+// The bytes of the regular file `path` (at most `cap`) in one open, their digest remembered for
+// file_digest: an input read to be decoded is not read again for the manifests. nullopt when it
+// is not a regular file, cannot be read or holds more than `cap` bytes (the caller then reads it
+// the ordinary way, which words the error).
+std::optional<std::string> read_input_file(const std::string& path, std::size_t cap);
 
 }  // namespace emaki::io

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -79,6 +80,25 @@ TEST_F(OutputStore, FileDigestFollowsContent) {
   EXPECT_EQ(file_digest((dir_ / "a").string()), file_digest((dir_ / "a").string()));
   EXPECT_NE(file_digest((dir_ / "a").string()), file_digest((dir_ / "b").string()));
   EXPECT_EQ(file_digest((dir_ / "none").string()), "missing");
+}
+
+// The digest is remembered per file identity: a file rewritten (another modification time)
+// gets its new digest, and an input read whole has its digest without a second read.
+TEST_F(OutputStore, FileDigestIsRememberedUntilTheFileChanges) {
+  const std::string a = (dir_ / "a").string();
+  std::ofstream(a) << "hello";
+  const std::string first = file_digest(a);
+  std::ofstream(a) << "hellp";
+  fs::last_write_time(a, fs::last_write_time(a) + std::chrono::seconds(2));
+  EXPECT_NE(file_digest(a), first);
+  const std::string b = (dir_ / "b").string();
+  std::ofstream(b) << "hello";
+  const std::optional<std::string> bytes = read_input_file(b, 100);
+  ASSERT_TRUE(bytes.has_value());
+  EXPECT_EQ(*bytes, "hello");
+  EXPECT_EQ(file_digest(b), first);
+  EXPECT_FALSE(read_input_file(b, 4).has_value());                // over its cap
+  EXPECT_FALSE(read_input_file(dir_.string(), 100).has_value());  // a folder
 }
 
 }  // namespace

@@ -107,19 +107,24 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
   }
 }
 
+// What a MatCap-like exemplar's reference passes are rendered from (but the painting's size).
+void add_reference(Lines& l, const std::string& p, const pipeline::Exemplar& e) {
+  const exemplar::ReferenceSpec& r = e.reference;
+  l.add(p + "reference",
+        fmt::format("center {} radius {} elevation {} horizon {} fov {} ground {} {} "
+                    "background {} aa {}",
+                    v2(r.center), r.radius, r.elevation_deg, r.horizon_row, r.fov_deg, r.ground,
+                    v3(r.ground_color), v3(r.background), e.aa));
+  add_light(l, p + "light.", r.light);
+}
+
 void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
   const std::string p = "exemplars." + e.name + ".";
   l.add(p + "kind", int(e.kind));
   l.add(p + "painting", canonical(e.painting));
   l.add(p + "painting.digest", file_digest(e.painting));
   if (e.kind == pipeline::ExemplarKind::kMatcap) {
-    const exemplar::ReferenceSpec& r = e.reference;
-    l.add(p + "reference",
-          fmt::format("center {} radius {} elevation {} horizon {} fov {} ground {} {} "
-                      "background {} aa {}",
-                      v2(r.center), r.radius, r.elevation_deg, r.horizon_row, r.fov_deg, r.ground,
-                      v3(r.ground_color), v3(r.background), e.aa));
-    add_light(l, p + "light.", r.light);
+    add_reference(l, p, e);
   } else {
     l.add(p + "passes", canonical(e.passes));
     l.add(p + "passes.digest", file_digest(e.passes));
@@ -161,6 +166,14 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
                   c.error_full, c.error_none, c.foreign_none, c.erode, layer.temporal.uniformity));
   l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
                                 layer.mask.dilate, layer.mask.threshold));
+  return l.m;
+}
+
+Manifest reference_manifest(const pipeline::Exemplar& exemplar, int width, int height) {
+  Lines l;
+  l.add("outputs_format", kOutputsFormat);
+  l.add("size", fmt::format("{}x{}", width, height));
+  add_reference(l, "", exemplar);
   return l.m;
 }
 

@@ -22,6 +22,10 @@ Manifest frames_manifest(const pipeline::Shot& shot);
 // The guide passes of a scene source's frames (the farm's pass cache, passes/frame_%04d.exr).
 Manifest passes_manifest(const pipeline::Shot& shot);
 
+// What a MatCap-like exemplar's reference passes at width x height (its painting's size) are
+// rendered from: the sphere, camera, light and anti-aliasing (store/reference_cache.h).
+Manifest reference_manifest(const pipeline::Exemplar& exemplar, int width, int height);
+
 // Whether files made under the manifest `have` (read from disk) are current for `want`. Inputs
 // are told apart by what they are, never by how a path to them was spelled: an input file's path
 // line is left out of the comparison wherever a `KEY.digest` line beside it holds the file's

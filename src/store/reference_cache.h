@@ -1,0 +1,31 @@
+// The reference passes of MatCap-like exemplars (the sphere rendered at the painting's size),
+// kept under a shot's output folder so that its run and each of its farm tasks need not render
+// them again: OUTPUT/references/KEY.exr (float, every pass), KEY a digest of everything the
+// render depends on (store/settings_manifests.h reference_manifest), and beside it KEY.digest,
+// the digest of its pixels, checked when it is read. Both are written through temporaries and
+// renamed (io/temp_file.h): a killed write or a full disk leaves no file that is read as a
+// reference; a file that fails its check is rendered again.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "core/image.h"
+#include "pipeline/shot_description.h"
+
+namespace emaki::io {
+
+// The file name stem of an exemplar's reference passes at width x height: 16 hex digits.
+std::string reference_key(const pipeline::Exemplar& exemplar, int width, int height);
+
+// The cached passes `key` in `output_folder`, or nullopt when they are missing, cut short, of
+// another size or channel count, or not the pixels their digest names.
+std::optional<Image<float>> read_reference(const std::string& output_folder, const std::string& key,
+                                           int width, int height);
+
+// Records `passes` as `key` in `output_folder` (creating references/). Throws emaki::Error naming
+// the file when it cannot be written.
+void write_reference(const std::string& output_folder, const std::string& key,
+                     ImageView<const float> passes);
+
+}  // namespace emaki::io

@@ -1,0 +1,74 @@
+#include "store/reference_cache.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "render/passes.h"
+
+namespace emaki::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ReferenceCache : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("emaki_refs_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+Image<float> passes(int w, int h) {
+  Image<float> im(w, h, render::kChannelCount);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < render::kChannelCount; ++c) im(x, y, c) = float(x * 3 + y * 5 + c) / 7;
+  return im;
+}
+
+TEST_F(ReferenceCache, KeysFollowWhatTheRenderDependsOn) {
+  pipeline::Exemplar e;
+  const std::string key = reference_key(e, 40, 30);
+  EXPECT_EQ(key.size(), 16u);
+  EXPECT_EQ(reference_key(e, 40, 30), key);
+  EXPECT_NE(reference_key(e, 41, 30), key);
+  pipeline::Exemplar lit = e;
+  lit.reference.light.softness_deg += 1;
+  EXPECT_NE(reference_key(lit, 40, 30), key);
+  pipeline::Exemplar aa = e;
+  aa.aa += 1;
+  EXPECT_NE(reference_key(aa, 40, 30), key);
+}
+
+TEST_F(ReferenceCache, KeptPassesReadBackExactlyAndOnlyWhenTheyCheck) {
+  const std::string out = dir_.string(), key = "0123456789abcdef";
+  EXPECT_FALSE(read_reference(out, key, 9, 7).has_value());
+  const Image<float> im = passes(9, 7);
+  write_reference(out, key, im.cview());
+  const std::optional<Image<float>> back = read_reference(out, key, 9, 7);
+  ASSERT_TRUE(back.has_value());
+  for (int y = 0; y < 7; ++y)
+    for (int x = 0; x < 9; ++x)
+      for (int c = 0; c < render::kChannelCount; ++c) ASSERT_EQ((*back)(x, y, c), im(x, y, c));
+  EXPECT_FALSE(read_reference(out, key, 9, 8).has_value());  // another painting size
+  // Pixels that are not the ones their digest names are not a reference.
+  const fs::path digest = dir_ / "references" / (key + ".digest");
+  std::ofstream(digest) << "ffffffffffffffff\n";
+  EXPECT_FALSE(read_reference(out, key, 9, 7).has_value());
+  // Written again, it reads again; without its digest file it is not read.
+  write_reference(out, key, im.cview());
+  EXPECT_TRUE(read_reference(out, key, 9, 7).has_value());
+  fs::remove(digest);
+  EXPECT_FALSE(read_reference(out, key, 9, 7).has_value());
+}
+
+}  // namespace
+}  // namespace emaki::io
