@@ -19,9 +19,6 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // lightened it frame by frame (docs/design/temporal-default.md).
       d.temporal_weight = 0.0f;
       d.temporal_uniformity = 0.0f;
-      // The tone anchor's quarter-size field blurs the shadow's edge: uncovered pixels took lit
-      // patches (sunset shot, 24 frames: 12 levels of 255 lighter than frame by frame there).
-      d.temporal_anchor_holes = false;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};

@@ -100,9 +100,6 @@ struct KindDefaults {
   composite::LayerLook look;
   float temporal_weight = 1.0f;
   float temporal_uniformity = 1000.0f;
-  // The tone anchor's field at uncovered pixels (pipeline::TemporalSpec::anchor_holes): not in
-  // the shot file.
-  bool temporal_anchor_holes = true;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

@@ -73,10 +73,6 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_FLOAT_EQ(s.layers[1].temporal.uniformity, 0.0f);
   EXPECT_FLOAT_EQ(s.layers[2].temporal.weight, 0.0f);
   EXPECT_FLOAT_EQ(s.layers[2].temporal.uniformity, 0.0f);
-  // The tone anchor's field at uncovered pixels: not on the shadow (docs/design/tone-anchor.md).
-  EXPECT_TRUE(s.layers[0].temporal.anchor_holes);   // base
-  EXPECT_TRUE(s.layers[1].temporal.anchor_holes);   // outline
-  EXPECT_FALSE(s.layers[2].temporal.anchor_holes);  // shadow
   EXPECT_EQ(s.layers[2].look.blend, composite::BlendMode::kMultiply);
   EXPECT_EQ(s.layers[2].guides[1].pass, "shadow");
   EXPECT_TRUE(s.layers[0].single_colour);
