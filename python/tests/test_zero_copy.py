@@ -18,8 +18,8 @@ def noise(shape, seed):
 
 def scribble_before_the_finest_level(*arrays):
     """A progress callback that sets every array to 0.25 as the finest level starts."""
-    def progress(level, levels):
-        if level == levels - 1:
+    def progress(p):
+        if p["level"] == p["levels"] - 1:
             for a in arrays:
                 a[...] = 0.25
     return progress
