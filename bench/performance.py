@@ -332,6 +332,16 @@ def section_python(a, build, emaki, tmp):
 SECTIONS = ("synth", "scaling", "memory", "render", "shot", "run", "temporal", "python")
 
 
+def printed_arguments(argv):
+    """The command line as the page shows it, with every path replaced by PATH."""
+    argv = list(argv)
+    for i, x in enumerate(argv[:-1]):
+        if x in ("--ebsynth", "--judge", "--build"):
+            argv[i + 1] = "PATH"
+    argv = [re.sub(r"^(--(?:ebsynth|judge|build)=).*", r"\1PATH", x) for x in argv]
+    return " ".join(argv)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
@@ -375,12 +385,7 @@ def main():
             else:
                 lines += section_python(a, build, emaki, tmp)
             lines.append("")
-    argv = sys.argv[1:]
-    for i, x in enumerate(argv[:-1]):
-        if x in ("--ebsynth", "--judge", "--build"):
-            argv[i + 1] = "PATH"
-    argv = [re.sub(r"^(--(?:ebsynth|judge|build)=).*", r"\1PATH", x) for x in argv]
-    args = " ".join(argv)
+    args = printed_arguments(sys.argv[1:])
     header = [
         "# Performance", "",
         "Every figure on this page is printed by `bench/performance.py`, which runs the release "

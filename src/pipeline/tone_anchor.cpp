@@ -45,6 +45,22 @@ float sample(const Image<float>& im, float x, float y, int c) {
          (im(x0, y1, c) * (1 - fx) + im(x1, y1, c) * fx) * fy;
 }
 
+// The small transfer's field at full size: each small pixel's patch spread over the block of
+// 2^halvings pixels it covers, offset within it; (-1, -1) stays outside.
+Image<int32_t> spread_field(const Image<int32_t>& small, int width, int height, int halvings) {
+  Image<int32_t> out(width, height, 2);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int xs = std::min(x >> halvings, small.width() - 1);
+      const int ys = std::min(y >> halvings, small.height() - 1);
+      const int32_t sx = small(xs, ys, 0), sy = small(xs, ys, 1);
+      const bool in = sx >= 0 && sy >= 0;
+      out(x, y, 0) = in ? (sx << halvings) + (x - (xs << halvings)) : -1;
+      out(x, y, 1) = in ? (sy << halvings) + (y - (ys << halvings)) : -1;
+    }
+  return out;
+}
+
 }  // namespace
 
 AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synth::Plane>& sources,
@@ -124,16 +140,7 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
   Anchor a;
   Image<float>& out = a.target;
   out.reset(advected.width, advected.height, n);
-  // The field, each small pixel's patch spread over the block it covers at full size.
-  a.nnf.reset(advected.width, advected.height, 2);
-  for (int y = 0; y < advected.height; ++y)
-    for (int x = 0; x < advected.width; ++x) {
-      const int xs = std::min(x >> halvings, sw - 1), ys = std::min(y >> halvings, sh - 1);
-      const int32_t fx0 = fresh.nnf(xs, ys, 0), fy0 = fresh.nnf(xs, ys, 1);
-      const bool in = fx0 >= 0 && fy0 >= 0;
-      a.nnf(x, y, 0) = in ? (fx0 << halvings) + (x - (xs << halvings)) : -1;
-      a.nnf(x, y, 1) = in ? (fy0 << halvings) + (y - (ys << halvings)) : -1;
-    }
+  a.nnf = spread_field(fresh.nnf, advected.width, advected.height, halvings);
   const float fx = float(sw) / float(advected.width), fy = float(sh) / float(advected.height);
   for (int y = 0; y < advected.height; ++y)
     for (int x = 0; x < advected.width; ++x)
