@@ -390,13 +390,19 @@ def marked(comments, start_line):
     return False
 
 
-def check_file(path, lister):
+def read_with_file_limit(path):
+    """The file's text, and the problem of its length when it is over the file limit."""
     problems = []
     with open(path, encoding="utf-8", errors="replace") as f:
         text = f.read()
     lines = text.count("\n") + (0 if text.endswith("\n") or not text else 1)
     if lines > MAX_FILE_LINES:
         problems.append((path, 0, f"{path}: {lines} lines (max {MAX_FILE_LINES})"))
+    return text, problems
+
+
+def check_file(path, lister):
+    text, problems = read_with_file_limit(path)
     is_test = path.startswith("tests/") or path.endswith("_test.cpp")
     code, comments = blank(text)
     for name, name_line, start, open_line, close_line, test_case in scan_functions(
@@ -428,12 +434,7 @@ def python_comments(text):
 
 
 def check_python_file(path, lister):
-    problems = []
-    with open(path, encoding="utf-8", errors="replace") as f:
-        text = f.read()
-    lines = text.count("\n") + (0 if text.endswith("\n") or not text else 1)
-    if lines > MAX_FILE_LINES:
-        problems.append((path, 0, f"{path}: {lines} lines (max {MAX_FILE_LINES})"))
+    text, problems = read_with_file_limit(path)
     name = os.path.basename(path)
     is_test = name.startswith("test_") or "/tests/" in "/" + path
     comments = python_comments(text)
