@@ -101,7 +101,7 @@ void add_temporal_guide(const PreparedLayer& p, ImageView<const float> passes,
   if (low)
     t.target = temporal::low_pass(t.advected.value.cview(), l.temporal.guide_sigma,
                                   mask.empty() ? ImageView<const float>{} : mask.cview());
-  synth::GuidePair pair{fmt::format("layers.{}.temporal", l.name),
+  synth::GuidePair pair{shot_keys::layer_key(l.name, shot_keys::kTemporal),
                         low ? p.temporal_style.cview() : p.style.cview(),
                         low ? t.target.cview() : t.advected.value.cview(), l.temporal.weight};
   if (!t.advected.confidence.empty()) pair.weight_map = synth::Plane(t.advected.confidence.cview());
@@ -168,12 +168,12 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   pass_maps.reserve(l.guides.size());
   synth::Inputs inputs;
   inputs.style = p.style.cview();
-  inputs.style_name = fmt::format("exemplars.{}.painting", l.exemplar);
+  inputs.style_name = shot_keys::exemplar_key(l.exemplar, shot_keys::kPainting);
   for (std::size_t i = 0; i < l.guides.size(); ++i) {
     const GuideSpec& g = l.guides[i];
     targets.push_back(extract_pass(passes, g.pass));
-    synth::GuidePair pair{fmt::format("layers.{}.guides.{}", l.name, g.pass),
-                          p.source_guides[i].cview(), targets.back().cview(), g.weight};
+    synth::GuidePair pair{shot_keys::layer_guide(l.name, g.pass), p.source_guides[i].cview(),
+                          targets.back().cview(), g.weight};
     if (!g.map_pass.empty()) {
       pass_maps.push_back(extract_pass(passes, g.map_pass));
       pair.weight_map = synth::Plane(pass_maps.back().cview());
