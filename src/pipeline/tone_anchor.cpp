@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 #include <variant>
 #include <vector>
 
 #include "core/check.h"
+#include "pipeline/frames.h"
 #include "synth/pyramid.h"
 #include "temporal/guide_change.h"
 
@@ -14,16 +14,14 @@ namespace emaki::pipeline {
 
 namespace {
 
+// A plane as floats, normalised as the synthesizer reads it (core/image.h).
 Image<float> to_float(const synth::Plane& plane) {
   return std::visit(
       [](const auto& v) {
-        using T = std::remove_const_t<std::remove_pointer_t<decltype(v.data)>>;
-        const float scale =
-            std::is_same_v<T, float> ? 1.0f : 1.0f / float((1 << (8 * sizeof(T))) - 1);
         Image<float> out(v.width, v.height, v.channels);
         for (int y = 0; y < v.height; ++y)
           for (int x = 0; x < v.width; ++x)
-            for (int c = 0; c < v.channels; ++c) out(x, y, c) = float(v(x, y, c)) * scale;
+            for (int c = 0; c < v.channels; ++c) out(x, y, c) = normalised(v(x, y, c));
         return out;
       },
       plane);
@@ -104,10 +102,7 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
     return {};
   Image<float> small_mask;
   if (!mask.empty()) {
-    Image<float> m(mask.width(), mask.height(), mask.channels());
-    for (int y = 0; y < m.height(); ++y)
-      for (int x = 0; x < m.width() * m.channels(); ++x) m.row(y)[x] = mask.row(y)[x];
-    small_mask = halve(std::move(m), halvings);
+    small_mask = halve(extract(mask.cview(), 0, mask.channels()), halvings);
     bool any = false;
     for (int y = 0; y < small_mask.height() && !any; ++y)
       for (int x = 0; x < small_mask.width() && !any; ++x) any = small_mask(x, y) > 0.5f;
@@ -123,11 +118,7 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
 
   // The difference, fresh minus carried, at the small size, low-passed inside the mask.
   const int n = value_channels;
-  Image<float> carried(advected.width, advected.height, n);
-  for (int y = 0; y < advected.height; ++y)
-    for (int x = 0; x < advected.width; ++x)
-      for (int c = 0; c < n; ++c) carried(x, y, c) = advected(x, y, c);
-  carried = halve(std::move(carried), halvings);
+  const Image<float> carried = halve(extract(advected, 0, n), halvings);
   const int sw = carried.width(), sh = carried.height();
   CHECK_EQ(fresh.image.width(), sw);
   Image<float> diff(sw, sh, n);
