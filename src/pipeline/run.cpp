@@ -9,6 +9,7 @@
 
 #include "composite/composite.h"
 #include "core/error.h"
+#include "core/fnv.h"
 #include "core/rng.h"
 #include "core/shot_keys.h"
 #include "pipeline/temporal_guide.h"
@@ -470,8 +471,8 @@ class ShotRun {
 
 uint64_t value_digest(ImageView<const float> value) {
   // FNV-1a, 64-bit, over 32-bit words: the size, then every sample's bit pattern.
-  uint64_t h = 0xcbf29ce484222325ull;
-  auto add = [&h](uint32_t w) { h = (h ^ w) * 0x100000001b3ull; };
+  uint64_t h = kFnvOffset;
+  auto add = [&h](uint32_t w) { h = fnv1a_add(h, w); };
   add(uint32_t(value.width)), add(uint32_t(value.height)), add(uint32_t(value.channels));
   for (int y = 0; y < value.height; ++y)
     for (int i = 0; i < value.width * value.channels; ++i)

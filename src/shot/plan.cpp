@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/fnv.h"
 #include "core/limits.h"
 #include "core/utf8.h"
 #include "io/image_io.h"
@@ -113,9 +114,7 @@ std::string shot_name(const std::string& path) {
   std::error_code ec;
   fs::path canonical = fs::weakly_canonical(path, ec);
   if (ec) canonical = fs::absolute(path).lexically_normal();
-  uint64_t h = 0xcbf29ce484222325ull;
-  for (const char c : canonical.string())
-    h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
+  const uint64_t h = fnv1a(canonical.string());
   return fmt::format("{}-{:08x}", fs::path(path).stem().string(), uint32_t(h ^ (h >> 32)));
 }
 

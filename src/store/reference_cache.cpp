@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/fnv.h"
 #include "io/image_io.h"
 #include "io/temp_file.h"
 #include "pipeline/run.h"
@@ -30,9 +31,9 @@ std::string digest_text(ImageView<const float> passes) {
 
 std::string reference_key(const pipeline::Exemplar& exemplar, int width, int height) {
   // FNV-1a over the manifest's lines.
-  uint64_t h = 0xcbf29ce484222325ull;
+  uint64_t h = kFnvOffset;
   for (const std::string& line : reference_manifest(exemplar, width, height))
-    for (const char c : line + "\n") h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
+    h = fnv1a(line + "\n", h);
   return fmt::format("{:016x}", h);
 }
 
