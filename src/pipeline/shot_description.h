@@ -145,7 +145,16 @@ struct TemporalSpec {
   // not the leftovers of the carried field). Not in the shot file: measured defaults.
   int anchor = 2;
   float anchor_sigma = 4.0f;
+  // The share of the difference moved at each frame (1: all of it); below 1 the anchored tone
+  // follows the fresh transfers' as a running mean along the chain, which averages their noise.
+  float anchor_rate = 1.0f;
+  // Search-vote iterations at the fresh transfer's finest level (-1: the schedule's).
+  int anchor_finest_iters = -1;
   bool anchor_holes = true;
+  // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
+  // iterations in each.
+  int finest_iters = 1;
+  int warm_patch_match_iters = 2;
 };
 
 struct SynthSpec {
