@@ -129,8 +129,7 @@ std::shared_ptr<const Config> Config::from_file(const std::string& path,
   return std::shared_ptr<const Config>(new Config(std::move(impl)));
 }
 
-std::shared_ptr<const Config> Config::open(const std::string& shot_config,
-                                           const std::string& key) {
+std::shared_ptr<const Config> Config::open(const std::string& shot_config, const std::string& key) {
   if (const char* env = std::getenv("OCIO"); env && *env) return from_file(env, "$OCIO");
   if (!shot_config.empty()) return from_file(shot_config, key);
   return builtin();
@@ -158,8 +157,8 @@ std::string Config::resolve(std::string_view name) const {
 
 void Config::require_space(const std::string& key, const std::string& name) const {
   if (!resolve(name).empty()) return;
-  throw Error(key, fmt::format("unknown colour space '{}' in {}; nearest: {}", name,
-                               impl_->origin, quoted_list(nearest_names(name, space_names()))));
+  throw Error(key, fmt::format("unknown colour space '{}' in {}; nearest: {}", name, impl_->origin,
+                               quoted_list(nearest_names(name, space_names()))));
 }
 
 std::pair<std::string, std::string> Config::require_display_view(const std::string& display_key,
@@ -197,13 +196,41 @@ std::string Config::view_space(const std::string& display, const std::string& vi
   return name ? resolve(name) : "";
 }
 
+std::vector<float> Config::chromaticities(const std::string& space) const {
+  if (role("aces_interchange").empty() || resolve(space).empty() || is_data(space)) return {};
+  const auto cpu = impl_->processor(
+      space + "\nchromaticities",
+      [&] {
+        OCIO::ColorSpaceTransformRcPtr to_aces = OCIO::ColorSpaceTransform::Create();
+        to_aces->setSrc(space.c_str());
+        to_aces->setDst("aces_interchange");
+        OCIO::BuiltinTransformRcPtr to_xyz = OCIO::BuiltinTransform::Create();
+        to_xyz->setStyle("UTILITY - ACES-AP0_to_CIE-XYZ-D65_BFD");
+        OCIO::GroupTransformRcPtr g = OCIO::GroupTransform::Create();
+        g->appendTransform(to_aces);
+        g->appendTransform(to_xyz);
+        return impl_->config->getProcessor(g);
+      },
+      fmt::format("'{}' to CIE XYZ", space));
+  std::vector<float> out;
+  constexpr float kPrimariesAndWhite[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  for (const auto& rgb : kPrimariesAndWhite) {
+    float xyz[3] = {rgb[0], rgb[1], rgb[2]};
+    cpu->applyRGB(xyz);
+    const float sum = xyz[0] + xyz[1] + xyz[2];
+    if (!(sum > 0.0f)) return {};
+    out.push_back(xyz[0] / sum);
+    out.push_back(xyz[1] / sum);
+  }
+  return out;
+}
+
 bool Config::is_identity(const std::string& src, const std::string& dst) const {
   const std::string a = resolve(src), b = resolve(dst);
   return a == b || is_data(a) || is_data(b);
 }
 
-void Config::convert(ImageView<float> image, const std::string& src,
-                     const std::string& dst) const {
+void Config::convert(ImageView<float> image, const std::string& src, const std::string& dst) const {
   if (is_identity(src, dst)) return;
   const auto cpu = impl_->processor(
       src + '\n' + dst, [&] { return impl_->config->getProcessor(src.c_str(), dst.c_str()); },
@@ -211,8 +238,8 @@ void Config::convert(ImageView<float> image, const std::string& src,
   apply(cpu, image);
 }
 
-void Config::to_display(ImageView<float> image, const std::string& src,
-                        const std::string& display, const std::string& view) const {
+void Config::to_display(ImageView<float> image, const std::string& src, const std::string& display,
+                        const std::string& view) const {
   const std::string space = view_space(display, view);
   if (!space.empty() && is_identity(src, space)) return;
   const auto cpu = impl_->processor(

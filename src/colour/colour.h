@@ -29,8 +29,7 @@ class Config {
  public:
   // $OCIO when set, else `shot_config` (a path; empty: none), else the built-in config. An
   // unreadable or broken config is an emaki::Error naming $OCIO or `key`.
-  static std::shared_ptr<const Config> open(const std::string& shot_config,
-                                            const std::string& key);
+  static std::shared_ptr<const Config> open(const std::string& shot_config, const std::string& key);
   static std::shared_ptr<const Config> builtin();
   // `subject` names the file in errors (a key, "$OCIO", or the path itself).
   static std::shared_ptr<const Config> from_file(const std::string& path,
@@ -58,6 +57,13 @@ class Config {
   bool is_data(const std::string& space) const;
   // The colour space a display's view writes ("" for a view transform's display space).
   std::string view_space(const std::string& display, const std::string& view) const;
+
+  // The chromaticities of `space`'s RGB (red, green, blue, white x y), as OpenEXR's attribute
+  // holds them: its primaries and white converted to CIE XYZ through the config's
+  // aces_interchange role and OpenColorIO's ACES AP0 -> XYZ (D65, Bradford) transform, so a
+  // Rec.709-based space gives Rec.709 / D65 exactly. Empty when the config has no such role or
+  // the space is data.
+  std::vector<float> chromaticities(const std::string& space) const;
 
   // True when converting `src` to `dst` changes nothing: the same space, or either one data.
   bool is_identity(const std::string& src, const std::string& dst) const;

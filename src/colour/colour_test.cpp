@@ -2,9 +2,8 @@
 // reference, not against emaki's formulas.
 #include "colour/colour.h"
 
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -42,10 +41,18 @@ class ColourTest : public ::testing::Test {
 
 // A patch of known colours: black, white, greys, primaries, a skin tone, out-of-range values.
 Image<float> patch() {
-  const float v[][3] = {{0, 0, 0},       {1, 1, 1},          {0.18f, 0.18f, 0.18f},
-                        {0.5f, 0.5f, 0.5f}, {1, 0, 0},       {0, 1, 0},
-                        {0, 0, 1},       {0.8f, 0.55f, 0.42f}, {0.02f, 0.3f, 0.9f},
-                        {0.003f, 0.04f, 0.25f}, {0.95f, 0.9f, 0.1f}, {0.6f, 0.2f, 0.7f}};
+  const float v[][3] = {{0, 0, 0},
+                        {1, 1, 1},
+                        {0.18f, 0.18f, 0.18f},
+                        {0.5f, 0.5f, 0.5f},
+                        {1, 0, 0},
+                        {0, 1, 0},
+                        {0, 0, 1},
+                        {0.8f, 0.55f, 0.42f},
+                        {0.02f, 0.3f, 0.9f},
+                        {0.003f, 0.04f, 0.25f},
+                        {0.95f, 0.9f, 0.1f},
+                        {0.6f, 0.2f, 0.7f}};
   const int n = int(std::size(v));
   Image<float> img(n, 1, 3);
   for (int x = 0; x < n; ++x)
@@ -63,11 +70,10 @@ void write_pfm(const std::string& path, const Image<float>& img) {
       for (int c = 0; c < 3; ++c) out.write(reinterpret_cast<const char*>(&img(x, y, c)), 4);
 }
 
-
 std::string temp_dir() {
-  const fs::path d = fs::temp_directory_path() /
-                     ("emaki_colour_test_" + std::to_string(::getpid()) + "_" +
-                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path d =
+      fs::temp_directory_path() / ("emaki_colour_test_" + std::to_string(::getpid()) + "_" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::create_directories(d);
   return d.string();
 }
@@ -77,8 +83,10 @@ std::string temp_dir() {
 bool run_tool(const std::string& config, const std::vector<std::string>& argv) {
   const pid_t pid = ::fork();
   if (pid == 0) {
-    if (config.empty()) ::unsetenv("OCIO");
-    else ::setenv("OCIO", config.c_str(), 1);
+    if (config.empty())
+      ::unsetenv("OCIO");
+    else
+      ::setenv("OCIO", config.c_str(), 1);
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, 1);
     ::dup2(null, 2);
@@ -209,9 +217,9 @@ TEST_F(ColourTest, ConvertKeepsAlpha) {
 // Data and same-space conversions change nothing, bit for bit (the defaults keep today's bytes).
 TEST_F(ColourTest, IdentityIsExact) {
   const auto config = Config::builtin();
-  for (const auto& [src, dst] : {std::pair{kSrgbTexture, kSrgbTexture},
-                                 std::pair{kRaw, kSceneLinear}, std::pair{kAcescg, kRaw},
-                                 std::pair{"color_picking", kSrgbTexture}}) {
+  for (const auto& [src, dst] :
+       {std::pair{kSrgbTexture, kSrgbTexture}, std::pair{kRaw, kSceneLinear},
+        std::pair{kAcescg, kRaw}, std::pair{"color_picking", kSrgbTexture}}) {
     EXPECT_TRUE(config->is_identity(src, dst)) << src << " " << dst;
     Image<float> img = patch();
     config->convert(img.view(), src, dst);
@@ -219,6 +227,24 @@ TEST_F(ColourTest, IdentityIsExact) {
     for (int x = 0; x < img.width(); ++x)
       for (int c = 0; c < 3; ++c) EXPECT_EQ(img(x, 0, c), want(x, 0, c));
   }
+}
+
+// OpenEXR's chromaticities: Rec.709 / D65 for the Rec.709-based spaces, ACEScg's AP1 primaries
+// as seen from D65, none for data.
+TEST_F(ColourTest, Chromaticities) {
+  const auto config = Config::builtin();
+  const std::vector<float> rec709 = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+  for (const char* space : {kSceneLinear, kSrgbTexture, "color_picking"}) {
+    const std::vector<float> c = config->chromaticities(space);
+    ASSERT_EQ(c.size(), 8u) << space;
+    for (int i = 0; i < 8; ++i) EXPECT_NEAR(c[i], rec709[i], 1e-4) << space << " " << i;
+  }
+  const std::vector<float> ap1 = config->chromaticities(kAcescg);
+  ASSERT_EQ(ap1.size(), 8u);
+  EXPECT_NEAR(ap1[0], 0.713f, 2e-3);
+  EXPECT_NEAR(ap1[3], 0.839f, 2e-3);  // AP1 green y (0.830 at D60), adapted to D65
+  EXPECT_NEAR(ap1[6], 0.3127f, 1e-4);
+  EXPECT_TRUE(config->chromaticities(kRaw).empty());
 }
 
 TEST_F(ColourTest, UnknownSpaceNamesKeyAndNearest) {

@@ -14,6 +14,7 @@ import PyOpenColorIO as ocio
 
 SCENE_LINEAR = "scene-linear Rec.709"
 ACESCG = "ACEScg"
+ACES = "ACES2065-1"
 SRGB_TEXTURE = "sRGB texture"
 RAW = "raw"
 FILMIC = "sRGB filmic"
@@ -36,6 +37,7 @@ def make_config():
     config.setMinorVersion(1)
     config.setName("emaki")
     config.setDescription("emaki's built-in config: scene-linear Rec.709 reference, ACEScg, "
+                          "ACES2065-1, "
                           "sRGB texture, raw data; an sRGB display with a Standard and a "
                           "Filmic view. Written by tools/colour/make_config.py.")
     config.setSearchPath("")
@@ -47,6 +49,13 @@ def make_config():
     config.addColorSpace(colour_space(
         ACESCG, "Linear", "linear light, ACES AP1 primaries (ACEScg)",
         to_reference=ocio.BuiltinTransform("UTILITY - ACES-AP1_to_LINEAR-REC709_BFD")))
+    # The interchange space (the aces_interchange role), through which emaki works out the
+    # chromaticities it writes into EXR headers.
+    config.addColorSpace(colour_space(
+        ACES, "Linear", "linear light, ACES AP0 primaries (ACES2065-1, interchange)",
+        to_reference=ocio.GroupTransform([
+            ocio.BuiltinTransform("ACEScg_to_ACES2065-1", ocio.TRANSFORM_DIR_INVERSE),
+            ocio.BuiltinTransform("UTILITY - ACES-AP1_to_LINEAR-REC709_BFD")])))
     # The sRGB curve (IEC 61966-2-1) on Rec.709 primaries: what paintings and scans hold.
     config.addColorSpace(colour_space(
         SRGB_TEXTURE, "Texture", "sRGB-encoded Rec.709: paintings, paper scans, 8-bit images",
@@ -72,7 +81,8 @@ def make_config():
                         (ocio.ROLE_COMPOSITING_LOG, SCENE_LINEAR),
                         (ocio.ROLE_COLOR_PICKING, SRGB_TEXTURE),
                         (ocio.ROLE_TEXTURE_PAINT, SRGB_TEXTURE),
-                        (ocio.ROLE_MATTE_PAINT, SRGB_TEXTURE), (ocio.ROLE_DATA, RAW)]:
+                        (ocio.ROLE_MATTE_PAINT, SRGB_TEXTURE), (ocio.ROLE_DATA, RAW),
+                        ("aces_interchange", ACES)]:
         config.setRole(role, space)
 
     # CreateRaw's own display (sRGB: Raw) goes, so that Standard is the display's first view.
