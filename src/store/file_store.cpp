@@ -358,7 +358,7 @@ WriteOptions FileStore::exr_options() const {
   WriteOptions wo;
   wo.format = SampleFormat::kHalf;
   const std::string space = working_space();
-  wo.attributes = {{"colorSpace", space}, {"oiio:ColorSpace", space}};
+  wo.attributes = {{"colorSpace", space}};
   wo.chromaticities = shot_.colour.get().chromaticities(space);
   return wo;
 }
