@@ -62,8 +62,8 @@ int main(int argc, char** argv) {
     for (int i = 0; i < repeats; ++i) {
       const auto t0 = std::chrono::steady_clock::now();
       s.run();
-      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-                                .count());
+      best = std::min(best,
+                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     std::printf("  %-48s %7.2f ms x %d\n", s.name, best * 1e3, s.per_frame);
     total += best * s.per_frame;
