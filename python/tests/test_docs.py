@@ -10,7 +10,8 @@ import pytest
 import emaki
 
 STUB = pathlib.Path(__file__).resolve().parents[1] / "emaki.pyi"
-FUNCTIONS = ["synthesize", "read_image", "write_image", "image_channels", "render", "template"]
+FUNCTIONS = ["synthesize", "read_image", "write_image", "image_channels", "render", "template",
+             "convert_colorspace"]
 
 
 def signature(fn_def):

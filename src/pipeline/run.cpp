@@ -266,7 +266,12 @@ Image<float> composite_frame(const Shot& shot, ImageView<const float> passes,
   paper.texture = ci.paper.empty() ? ImageView<const float>{} : ci.paper.cview();
   paper.scale = shot.compositing.paper_scale;
   paper.color = shot.compositing.paper_color;
-  return composite::composite(inputs, paper, passes.width, passes.height);
+  if (shot.compositing.space == CompositingSpace::kDisplay)
+    return composite::composite(inputs, paper, passes.width, passes.height);
+  const colour::Config& config = shot.colour.get();
+  return composite::composite(
+      inputs, paper, passes.width, passes.height,
+      [&](ImageView<float> rgb) { config.convert(rgb, "color_picking", "scene_linear"); });
 }
 
 namespace {
