@@ -17,6 +17,7 @@
 #include "io/image_io.h"
 #include "tests/cli_run.h"
 #include "tests/small_painting.h"
+#include "tests/test_dir.h"
 
 namespace fs = std::filesystem;
 using namespace emaki;
@@ -69,11 +70,7 @@ class ColourCli : public ::testing::Test {
  protected:
   void SetUp() override {
     ::unsetenv("OCIO");  // the built-in config, whatever the machine sets
-    dir_ = fs::temp_directory_path() /
-           ("emaki_colour_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::fresh_test_dir("emaki_colour");
     test::write_small_painting(kData + "/stylit/source_style.png", p("painting.png"));
   }
   void TearDown() override { fs::remove_all(dir_); }

@@ -20,6 +20,7 @@
 #include "core/image.h"
 #include "io/image_io.h"
 #include "tests/small_painting.h"
+#include "tests/test_dir.h"
 
 namespace fs = std::filesystem;
 using namespace emaki;
@@ -76,11 +77,7 @@ bool is_one_line(const std::string& s) {
 class OutputSafety : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_outsafe_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::fresh_test_dir("emaki_outsafe");
     test::write_small_painting(kData + "/stylit/source_style.png", p("painting.png"));
   }
   void TearDown() override {

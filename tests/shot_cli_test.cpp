@@ -23,6 +23,7 @@
 #include "store/field_file.h"
 #include "store/file_store.h"
 #include "tests/small_painting.h"
+#include "tests/test_dir.h"
 
 extern char** environ;
 
@@ -105,11 +106,7 @@ contact_sheet = false
 class ShotCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_shot_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::fresh_test_dir("emaki_shot");
     test::write_small_painting(kData + "/stylit/source_style.png", p("painting.png"));
   }
   void TearDown() override { fs::remove_all(dir_); }

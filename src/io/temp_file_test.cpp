@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "tests/test_dir.h"
 
 namespace emaki::io {
 namespace {
@@ -23,13 +24,7 @@ std::string slurp(const fs::path& p) {
 
 class TempFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_temp_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = test::fresh_test_dir("emaki_temp"); }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
 };

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/version.h"
 #include "store/settings_manifests.h"
+#include "tests/test_dir.h"
 
 namespace emaki::io {
 namespace {
@@ -20,13 +21,7 @@ namespace fs = std::filesystem;
 
 class OutputStore : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_store_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = test::fresh_test_dir("emaki_store"); }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
 };

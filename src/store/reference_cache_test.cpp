@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "render/passes.h"
+#include "tests/test_dir.h"
 
 namespace emaki::io {
 namespace {
@@ -15,13 +16,7 @@ namespace fs = std::filesystem;
 
 class ReferenceCache : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("emaki_refs_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = test::fresh_test_dir("emaki_refs"); }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
 };
