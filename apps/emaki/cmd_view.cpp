@@ -1,8 +1,8 @@
 // `emaki view OUTPUT [OUTPUT_B]`: the output folders of shots on a local page (src/view/):
 // a frame player, the layers, an A/B wipe, the contact sheet and the manifests.
-#include <CLI/CLI.hpp>
 #include <signal.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>
 #include <vector>

@@ -130,25 +130,30 @@ std::string json_array(const std::vector<T>& v, F each) {
 }
 
 std::string sequence_json(const Sequence& q) {
-  return fmt::format(
-      "{{\"name\":{},\"frames\":{},\"files\":{},\"stamps\":{}}}", json(q.name),
-      json_array(q.frames, [](int f) { return std::to_string(f); }),
-      json_array(q.files, json), json_array(q.stamps, [](long long t) { return std::to_string(t); }));
+  return fmt::format("{{\"name\":{},\"frames\":{},\"files\":{},\"stamps\":{}}}", json(q.name),
+                     json_array(q.frames, [](int f) { return std::to_string(f); }),
+                     json_array(q.files, json),
+                     json_array(q.stamps, [](long long t) { return std::to_string(t); }));
 }
 
 }  // namespace
 
 std::string listing_json(const std::vector<Listing>& listings) {
-  return "{\"outputs\":" + json_array(listings, [](const Listing& l) {
-           return fmt::format(
-               "{{\"folder\":{},\"sequences\":{},\"contact_sheet\":{},\"contact_sheet_stamp\":{},"
-               "\"manifests\":{}}}",
-               json(l.folder), json_array(l.sequences, sequence_json), json(l.contact_sheet),
-               l.contact_sheet_stamp, json_array(l.manifests, [](const auto& m) {
-                 return fmt::format("{{\"folder\":{},\"text\":{}}}", json(m.first),
-                                    json(m.second));
-               }));
-         }) + "}";
+  return "{\"outputs\":" +
+         json_array(listings,
+                    [](const Listing& l) {
+                      return fmt::format(
+                          "{{\"folder\":{},\"sequences\":{},\"contact_sheet\":{},\"contact_sheet_"
+                          "stamp\":{},"
+                          "\"manifests\":{}}}",
+                          json(l.folder), json_array(l.sequences, sequence_json),
+                          json(l.contact_sheet), l.contact_sheet_stamp,
+                          json_array(l.manifests, [](const auto& m) {
+                            return fmt::format("{{\"folder\":{},\"text\":{}}}", json(m.first),
+                                               json(m.second));
+                          }));
+                    }) +
+         "}";
 }
 
 }  // namespace emaki::view

@@ -18,9 +18,9 @@ struct Sequence {
 };
 
 struct Listing {
-  std::string folder;            // as given on the command line
+  std::string folder;               // as given on the command line
   std::vector<Sequence> sequences;  // composite first, then layers/*, then the others by name
-  std::string contact_sheet;     // "contact_sheet.png" or empty
+  std::string contact_sheet;        // "contact_sheet.png" or empty
   long long contact_sheet_stamp = 0;
   std::vector<std::pair<std::string, std::string>> manifests;  // (folder, text)
 };

@@ -129,7 +129,8 @@ struct Server::Impl {
   void routes() {
     for (int i = 0; i < kPageFileCount; ++i) {
       const PageFile& f = kPageFiles[i];
-      const std::string path = std::string("/") + (std::string(f.name) == "index.html" ? "" : f.name);
+      const std::string path =
+          std::string("/") + (std::string(f.name) == "index.html" ? "" : f.name);
       http.Get(path, [&f](const httplib::Request&, httplib::Response& res) {
         res.set_content(reinterpret_cast<const char*>(f.data), f.size, content_type(f.name));
       });
@@ -192,7 +193,9 @@ Server::Server(std::vector<fs::path> folders, ServerOptions options, StatusJson 
   m_impl->routes();
 }
 
-Server::~Server() { stop(); }
+Server::~Server() {
+  stop();
+}
 
 int Server::start() {
   Impl& m = *m_impl;
@@ -203,7 +206,8 @@ int Server::start() {
   } else {
     if (!m.http.bind_to_port(bind, m.options.port))
       throw Error(Error::Field{"port"}, "cannot listen on " + echo(bind) + ":" +
-                              std::to_string(m.options.port) + " (in use, or not this machine's)");
+                                            std::to_string(m.options.port) +
+                                            " (in use, or not this machine's)");
     m.port = m.options.port;
   }
   m.listener = std::thread([&m] {

@@ -30,8 +30,7 @@ class Server {
  public:
   // `folders`: the output folders, served as /files/0/..., /files/1/... Throws emaki::Error
   // naming the folder when one is not a readable folder.
-  Server(std::vector<std::filesystem::path> folders, ServerOptions options,
-         StatusJson status = {});
+  Server(std::vector<std::filesystem::path> folders, ServerOptions options, StatusJson status = {});
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

@@ -56,8 +56,7 @@ std::pair<int, std::string> raw_get(int port, const std::string& target,
   ::close(s);
   if (reply.rfind("HTTP/1.1 ", 0) != 0) return {0, reply};
   const std::size_t body = reply.find("\r\n\r\n");
-  return {std::stoi(reply.substr(9, 3)),
-          body == std::string::npos ? "" : reply.substr(body + 4)};
+  return {std::stoi(reply.substr(9, 3)), body == std::string::npos ? "" : reply.substr(body + 4)};
 }
 
 class ViewServer : public ::testing::Test {
@@ -96,19 +95,19 @@ TEST_F(ViewServer, ServesThePageTheListingAndAFrame) {
   EXPECT_NE(listing.second.find("\"layers/base\""), std::string::npos) << listing.second;
   EXPECT_NE(listing.second.find("size = 4x4"), std::string::npos) << listing.second;
   EXPECT_EQ(listing.second.find("SECRET"), std::string::npos);
-  EXPECT_EQ(raw_get(port, "/files/0/composite/frame_0001.png"), std::make_pair(200, std::string("frame1")));
+  EXPECT_EQ(raw_get(port, "/files/0/composite/frame_0001.png"),
+            std::make_pair(200, std::string("frame1")));
   EXPECT_EQ(raw_get(port, "/files/0/composite/frame_0001.png?t=5").first, 200);
 }
 
 TEST_F(ViewServer, RefusesTraversalPlainAndEncoded) {
   for (const char* target :
        {"/files/0/../secret.txt", "/files/0/composite/../../secret.txt",
-        "/files/0/%2e%2e/secret.txt", "/files/0/%2E%2E/secret.txt",
-        "/files/0/..%2fsecret.txt", "/files/0/%2e%2e%2fsecret.txt",
-        "/files/0/composite/%2e%2e/%2e%2e/secret.txt", "/files/0/%252e%252e/secret.txt",
-        "/files/0/..%5csecret.txt", "/files/0/composite/frame_0000.png%00.txt",
-        "/files/1/composite/frame_0000.png", "/files/0/.emaki.lock",
-        "/files/0/layers/base/.emaki-manifest"}) {
+        "/files/0/%2e%2e/secret.txt", "/files/0/%2E%2E/secret.txt", "/files/0/..%2fsecret.txt",
+        "/files/0/%2e%2e%2fsecret.txt", "/files/0/composite/%2e%2e/%2e%2e/secret.txt",
+        "/files/0/%252e%252e/secret.txt", "/files/0/..%5csecret.txt",
+        "/files/0/composite/frame_0000.png%00.txt", "/files/1/composite/frame_0000.png",
+        "/files/0/.emaki.lock", "/files/0/layers/base/.emaki-manifest"}) {
     const auto r = raw_get(port, target);
     EXPECT_TRUE(r.first >= 400 && r.first < 500) << target << ": " << r.first;
     EXPECT_EQ(r.second.find("SECRET"), std::string::npos) << target;
@@ -116,9 +115,10 @@ TEST_F(ViewServer, RefusesTraversalPlainAndEncoded) {
 }
 
 TEST_F(ViewServer, RefusesAbsolutePathsAndSymlinksOut) {
-  for (const std::string& target : std::vector<std::string>{
-           "/files/0//etc/passwd", "/files/0/%2fetc%2fpasswd", "/files/0/" + base.string() + "/secret.txt",
-        "//etc/passwd", "/files/0/composite/frame_0002.png"}) {
+  for (const std::string& target :
+       std::vector<std::string>{"/files/0//etc/passwd", "/files/0/%2fetc%2fpasswd",
+                                "/files/0/" + base.string() + "/secret.txt", "//etc/passwd",
+                                "/files/0/composite/frame_0002.png"}) {
     const auto r = raw_get(port, target);
     EXPECT_TRUE(r.first >= 400 && r.first < 500) << target << ": " << r.first;
     EXPECT_EQ(r.second.find("SECRET"), std::string::npos) << target;

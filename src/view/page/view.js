@@ -108,7 +108,7 @@ function renderCompare() {
   const w = $("img-a").naturalWidth || $("img-a").width;
   b.style.clipPath = mode === "wipe" ? "inset(0 0 0 " + (state.wipe * 100) + "%)" : "";
   const line = $("wipe-line");
-  line.style.left = 10 + state.wipe * w + "px";
+  line.style.left = $("pane-a").offsetLeft + state.wipe * w + "px";
   line.style.height = ($("img-a").height || 0) + "px";
 }
 
