@@ -29,6 +29,8 @@ const std::vector<Command>& commands() {
       {"farm", "run shots on Slurm: 'emaki farm submit|status|cancel SHOT...'", run_farm},
       {"task", "one task of a plan, as a farm node runs it", run_task},
       {"view", "a local page of output folders: player, layers, A/B wipe, manifests", run_view},
+      {"lookdev", "a few preview frames made again on every save of the painting, on a page",
+       run_lookdev},
       {"version", "the version: the release, and the git revision when built from a checkout",
        run_version},
   };
