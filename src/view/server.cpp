@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 #include <httplib.h>
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -21,7 +23,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The largest file served: a preview.mp4 of a long shot stays below it.
+// The largest file served (streamed): a preview.mp4 of a long shot stays below it.
 constexpr std::uintmax_t kMaxServedFileBytes = std::uintmax_t(1) << 30;
 
 // httplib's task queue with a bound: `workers` threads, at most `limit` connections waiting.
@@ -119,11 +121,18 @@ struct Server::Impl {
     std::error_code ec;
     const auto size = fs::file_size(*file, ec);
     if (ec || size > kMaxServedFileBytes) return void(res.status = 404);
-    std::ifstream in(*file, std::ios::binary);
-    std::string body(size, '\0');
-    if (!in.read(body.data(), std::streamsize(size))) return void(res.status = 404);
+    // Streamed in pieces of 64 KiB: a worker holds one piece, whatever the file's size.
+    auto in = std::make_shared<std::ifstream>(*file, std::ios::binary);
+    if (!*in) return void(res.status = 404);
     res.set_header("Cache-Control", "no-cache");
-    res.set_content(std::move(body), content_type(*file));
+    res.set_content_provider(std::size_t(size), content_type(*file),
+                             [in](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+                               char buf[64 * 1024];
+                               in->seekg(std::streamoff(offset));
+                               in->read(buf, std::streamsize(std::min(length, sizeof buf)));
+                               const std::streamsize n = in->gcount();
+                               return n > 0 && sink.write(buf, std::size_t(n));
+                             });
   }
 
   void routes() {

@@ -100,6 +100,13 @@ TEST_F(ViewServer, ServesThePageTheListingAndAFrame) {
   EXPECT_EQ(raw_get(port, "/files/0/composite/frame_0001.png?t=5").first, 200);
 }
 
+TEST_F(ViewServer, StreamsALargeFileWhole) {
+  std::string big(300 * 1024 + 7, '\0');
+  for (std::size_t i = 0; i < big.size(); ++i) big[i] = char(i * 7 % 251);
+  std::ofstream(root / "contact_sheet.png", std::ios::binary) << big;
+  EXPECT_EQ(raw_get(port, "/files/0/contact_sheet.png"), std::make_pair(200, big));
+}
+
 TEST_F(ViewServer, RefusesTraversalPlainAndEncoded) {
   for (const char* target :
        {"/files/0/../secret.txt", "/files/0/composite/../../secret.txt",
