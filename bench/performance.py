@@ -409,6 +409,9 @@ def main():
         "- `bench/temporal_bench`: one layer of a shot run several ways (frame by frame, advection "
         "guides, confidence, uniformity, warm start, temporal weight), flicker, ghosts, drift and "
         "the judge ([guide.md](guide.md#reading-qa)).",
+        "- `bench/colour_bench [WxH] [SECONDS]`: the most colour management can add to a frame "
+        "(ACEScg passes, `scene_linear` compositing, the Filmic view), beside a temporal frame's "
+        "time from `shot_bench` ([shot_file.md](shot_file.md#colour-management)).",
         "- `bench/python_overhead.py` (the module's cost over the command line's synthesis, in "
         "instructions with `--instructions`) and `bench/python_gil.py` (two Python threads "
         "synthesizing at once).",

@@ -287,7 +287,16 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.anchor_sigma = x;
     } else if (key == "ah") {
       l.temporal.anchor_holes = x != 0.0f;
-
+    } else if (key == "ar") {
+      l.temporal.anchor_rate = x;
+    } else if (key == "e") {
+      l.temporal.confidence_params.erode = int(x);
+    } else if (key == "fi") {
+      l.temporal.finest_iters = int(x);
+    } else if (key == "ai") {
+      l.temporal.anchor_finest_iters = int(x);
+    } else if (key == "pm") {
+      l.temporal.warm_patch_match_iters = int(x);
     } else {
       usage("bad modifier " + m);
     }

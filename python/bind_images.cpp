@@ -1,4 +1,5 @@
-// emaki.read_image / write_image / image_channels: io/image_io.h over numpy arrays.
+// emaki.read_image / write_image / image_channels: io/image_io.h over numpy arrays;
+// emaki.convert_colorspace: colour/colour.h over one.
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "colour/colour.h"
 #include "core/limits.h"
 #include "io/image_io.h"
 #include "python/arrays.h"
@@ -55,6 +57,47 @@ Raises:
     emaki.InputError: a bad array, channel list or depth.
     emaki.FileError: the file cannot be written.
 )";
+
+constexpr const char* kConvertDoc =
+    R"(convert_colorspace(image, src, dst, config=None)
+
+Converts an image's colours from one OpenColorIO colour space to another, as a shot's inputs
+are converted (docs/shot_file.md, Colour management).
+
+Args:
+    image: HxWxC array with C >= 3, uint8, uint16 or float32 (integers mean [0, 1]); the first
+        three channels are converted, the others (alpha) kept.
+    src: the image's colour space (a name or a role of the config, e.g. 'sRGB texture',
+        'ACEScg', 'scene_linear').
+    dst: the colour space wanted.
+    config: an OpenColorIO config file (str or os.PathLike); None (default): $OCIO when set,
+        else emaki's built-in config.
+
+Returns:
+    A new HxWxC float32 array.
+
+Raises:
+    emaki.InputError: a bad array, an unknown colour space (naming src or dst and the nearest
+        names), or a config that cannot be used.
+)";
+
+py::array convert_colorspace(const py::handle& image, const std::string& src,
+                             const std::string& dst,
+                             const std::optional<std::filesystem::path>& config) {
+  const ArrayPlane a = array_plane(image, "image");
+  if (a.channels() < 3)
+    raise_input_error("image", fmt::format("has {} channels; needs at least 3", a.channels()));
+  Image<float> pixels = translating(ErrorKind::kInput, {}, [&] {
+    const std::shared_ptr<const colour::Config> c =
+        colour::Config::open(config ? config->string() : "", "config");
+    c->require_space("src", src);
+    c->require_space("dst", dst);
+    Image<float> out = to_float_image(a);
+    c->convert(out.view(), src, dst);
+    return out;
+  });
+  return to_array(pixels, SampleType::kF32, false);
+}
 
 py::array read_image(const std::filesystem::path& path,
                      const std::optional<std::vector<std::string>>& channels) {
@@ -116,6 +159,8 @@ void bind_images(py::module_& m) {
   m.def("read_image", &read_image, kReadDoc, py::arg("path"), py::arg("channels") = py::none());
   m.def("write_image", &write_image, kWriteDoc, py::arg("path"), py::arg("image"), py::kw_only(),
         py::arg("channels") = py::none(), py::arg("depth") = py::none());
+  m.def("convert_colorspace", &convert_colorspace, kConvertDoc, py::arg("image"), py::arg("src"),
+        py::arg("dst"), py::arg("config") = py::none());
   m.def("image_channels", &image_channels,
         "image_channels(path) -> list[str]\n\nThe channel names of every part of an image file, in "
         "order (e.g. 'normal.X', ...). "

@@ -83,6 +83,9 @@ def write_image(
     depth: Optional[Union[Literal["8", "16", "half", "float", 8, 16]]] = None,
 ) -> None: ...
 def image_channels(path: PathLike) -> list[str]: ...
+def convert_colorspace(
+    image: Array, src: str, dst: str, config: Optional[PathLike] = None
+) -> Array: ...
 def render(
     scene: PathLike,
     frame: int = 0,

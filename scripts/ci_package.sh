@@ -90,6 +90,9 @@ step "$(basename "$deb"): Depends: $(dpkg-deb -f "$deb" Depends)"
 if dpkg-deb -f "$deb" Depends | tr ',' '\n' | grep -q -- '-dev\b'; then
   fail "the runtime package depends on a -dev package"
 fi
+# The binary links OpenColorIO (src/colour): dpkg-shlibdeps must have found its runtime package.
+dpkg-deb -f "$deb" Depends | grep -q 'libopencolorio' ||
+  fail "the runtime package does not depend on OpenColorIO's library"
 [ ! -e /usr/bin/emaki ] || fail "/usr/bin/emaki exists before the install"
 installed=yes
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$deb" >/dev/null

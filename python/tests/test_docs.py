@@ -11,7 +11,7 @@ import emaki
 
 STUB = pathlib.Path(__file__).resolve().parents[1] / "emaki.pyi"
 FUNCTIONS = ["synthesize", "read_image", "write_image", "image_channels", "render", "template",
-             "view"]
+             "convert_colorspace", "view"]
 
 
 def signature(fn_def):

@@ -231,8 +231,9 @@ Image<float> paper_image(const Paper& paper, int width, int height) {
 }
 
 Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper, int width,
-                       int height) {
-  const Image<float> base = paper_image(paper, width, height);
+                       int height, const ToWorkingSpace& to_working) {
+  Image<float> base = paper_image(paper, width, height);
+  if (to_working) to_working(base.view());
   Image<float> out(width, height, 4);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -240,7 +241,8 @@ Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper
       out(x, y, 3) = 1.0f;
     }
   for (const LayerInput& layer : layers) {
-    const Image<float> rgba = color_layer(layer, width, height);
+    Image<float> rgba = color_layer(layer, width, height);
+    if (to_working) to_working(rgba.view());
     const BlendMode mode = layer.look.blend;
     parallel_rows(height, 16, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)

@@ -3,11 +3,13 @@
 // synthesized in; colour is applied only here, so changing a colour, a filter or a blend mode
 // never needs a new synthesis.
 //
-// Colour space: compositing works on display-referred (sRGB-encoded) values in [0, 1], as a
+// Colour space: layers are coloured on display-referred (sRGB-encoded) values in [0, 1], as a
 // painter's layer stack in Krita or Photoshop does; a linear albedo pass is encoded to sRGB
-// before it colours a layer, and a scanned paper is used as it comes from its PNG.
+// before it colours a layer, and the paper comes in display-referred. They are blended there
+// too, or in a working space the caller converts them to (composite()'s `to_working`).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -103,10 +105,16 @@ Image<float> color_layer(const LayerInput& layer, int width, int height);
 // The tiled paper, RGB.
 Image<float> paper_image(const Paper& paper, int width, int height);
 
+// Converts an image's RGB (its first three channels) in place, e.g. from display-referred values
+// to scene-linear ones (colour/colour.h does it; this module knows no colour space).
+using ToWorkingSpace = std::function<void(ImageView<float>)>;
+
 // Paper, then every layer from first (bottom) to last (top). Returns RGBA with alpha 1.
+// With `to_working`, the paper and each coloured layer (RGB, its alpha kept) go through it
+// before they are blended, and the blending is done on its values (no clamp to [0, 1]).
 // Throws emaki::Error naming the layer when its sizes do not match or an input it needs is
 // missing.
 Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper, int width,
-                       int height);
+                       int height, const ToWorkingSpace& to_working = {});
 
 }  // namespace emaki::composite

@@ -39,6 +39,16 @@ inline constexpr std::string_view kColor = "color";
 inline constexpr std::string_view kGradient = "gradient";
 // Exemplar keys named outside src/shot.
 inline constexpr std::string_view kPainting = "painting";
+inline constexpr std::string_view kColorspace = "colorspace";
+
+// Colour management (colour/colour.h): the config and the colour spaces, displays and views
+// named in it.
+inline constexpr const char* kColourConfig = "colour.config";
+inline constexpr const char* kPassesColorspace = "source.passes_colorspace";
+inline constexpr const char* kPaperColorspace = "compositing.paper_colorspace";
+inline constexpr const char* kCompositingSpace = "compositing.space";
+inline constexpr const char* kOutputsDisplay = "outputs.display";
+inline constexpr const char* kOutputsView = "outputs.view";
 
 inline constexpr const char* kPaperScale = "compositing.paper_scale";
 inline constexpr const char* kOutputsFolder = "outputs.folder";

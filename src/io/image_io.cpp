@@ -442,8 +442,7 @@ void write_image(const std::string& path, ImageView<const float> image,
   }
   {
     std::lock_guard lock(detail::oiio_mutex());
-    if (std::string e = detail::oiio_backend(path).write(tmp.path(), image, options.channel_names,
-                                                         type, options.compression);
+    if (std::string e = detail::oiio_backend(path).write(tmp.path(), image, options, type);
         !e.empty())
       throw Error(path, e);
   }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -80,6 +81,11 @@ struct WriteOptions {
   // An EXR's compression, as OpenImageIO names it: "zip" for what users keep; an intermediate
   // file read back by emaki alone may take a cheaper one.
   std::string compression = "zip";
+  // An EXR's header (other formats leave them out): string attributes (name, value), e.g. the
+  // colour space's name, and the chromaticities attribute (red, green, blue, white x y), when
+  // given.
+  std::vector<std::pair<std::string, std::string>> attributes;
+  std::vector<float> chromaticities;  // 8 values, or empty
 };
 
 // Writes a float image (values in [0,1] for integer formats, clamped and rounded). Atomic, and

@@ -313,15 +313,18 @@ std::string list_impl(const OiioSource& source, std::vector<std::string>& names)
 }
 
 std::string write_impl(const std::string& path, ImageView<const float> image,
-                       const std::vector<std::string>& names, int type_code,
-                       const std::string& compression) {
+                       const WriteOptions& options, int type_code) {
+  const std::vector<std::string>& names = options.channel_names;
   static const TypeDesc kTypes[4] = {TypeDesc::UINT8, TypeDesc::UINT16, TypeDesc::HALF,
                                      TypeDesc::FLOAT};
   ImageSpec spec(image.width, image.height, image.channels, kTypes[type_code]);
   if (!names.empty()) spec.channelnames = names;
   if (names.empty() && (image.channels == 4 || image.channels == 2))
     spec.alpha_channel = image.channels - 1;
-  spec.attribute("compression", compression);
+  spec.attribute("compression", options.compression);
+  for (const auto& [name, value] : options.attributes) spec.attribute(name, value);
+  if (options.chromaticities.size() == 8)
+    spec.attribute("chromaticities", TypeDesc(TypeDesc::FLOAT, 8), options.chromaticities.data());
   // OpenImageIO stamps EXRs with the time of writing (capDate) unless told a date: a fixed one
   // makes the same image the same file, so runs (and farm tasks) can be compared byte for byte.
   spec.attribute("DateTime", "2000:01:01 00:00:00");

@@ -32,10 +32,9 @@ struct OiioBackend {
                       AnyImage& out);
   std::string (*list_channels)(const OiioSource& source, std::vector<std::string>& out);
   // Writes to `path` exactly (the caller makes it atomic). `type`: 0 u8, 1 u16, 2 half, 3 float;
-  // `compression`: an EXR's ("zip", "none", ...).
+  // the options' compression, EXR attributes and chromaticities go into the header.
   std::string (*write)(const std::string& path, ImageView<const float> image,
-                       const std::vector<std::string>& channel_names, int type,
-                       const std::string& compression);
+                       const WriteOptions& options, int type);
 };
 
 // Loads the module (once); throws emaki::Error naming `subject` if it cannot.

@@ -77,10 +77,10 @@ struct LayerFrame {
 // runs at a temporal frame. Measured on the example (docs/design/warm-start.md): a random search
 // over the whole exemplar, or two search-vote iterations, evaluate more candidates and lowered the
 // judge's style energy by 0.7-2.2 % only (frames 4 and 12).
-void warm_schedule(const SynthSpec& s, synth::Params& p) {
+void warm_schedule(const SynthSpec& s, const TemporalSpec& t, synth::Params& p) {
   if (s.search_vote_iters >= 0 || s.patch_match_iters >= 0) return;
-  p.search_vote_iters = 1;
-  p.patch_match_iters = 2;
+  p.search_vote_iters = t.finest_iters;
+  p.patch_match_iters = t.warm_patch_match_iters;
   p.search_radius = 32;
 }
 
@@ -139,8 +139,9 @@ Image<int32_t> anchor_layer(const PreparedLayer& p, int frame, const synth::Para
   fresh.guides.pop_back();  // the temporal pair
   synth::Params fresh_params = params;
   fresh_params.seed = frame_seed(l, frame, 2);
+  fresh_params.finest_search_vote_iters = l.temporal.anchor_finest_iters;
   Anchor a = anchor_tone(fresh, p.anchor, fresh_params, t.advected.value.cview(), p.value_channels,
-                         mask, l.temporal.anchor_sigma);
+                         mask, l.temporal.anchor_sigma, l.temporal.anchor_rate);
   if (guide && !a.target.empty()) {
     t.target = std::move(a.target);
     inputs.guides.back().target = synth::Plane(t.target.cview());
@@ -200,13 +201,13 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   // about a quarter of the time per frame.
   Image<int32_t> warm;
   if (!advected.value.empty()) {
-    params.finest_search_vote_iters = 1;
+    params.finest_search_vote_iters = l.temporal.finest_iters;
     params.uniformity = l.temporal.uniformity;
     const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
       warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor_nnf);
       params.initial_nnf = warm.cview();
-      warm_schedule(l.synth, params);
+      warm_schedule(l.synth, l.temporal, params);
     }
   }
   synth::OutputRequest request;
@@ -265,7 +266,12 @@ Image<float> composite_frame(const Shot& shot, ImageView<const float> passes,
   paper.texture = ci.paper.empty() ? ImageView<const float>{} : ci.paper.cview();
   paper.scale = shot.compositing.paper_scale;
   paper.color = shot.compositing.paper_color;
-  return composite::composite(inputs, paper, passes.width, passes.height);
+  if (shot.compositing.space == CompositingSpace::kDisplay)
+    return composite::composite(inputs, paper, passes.width, passes.height);
+  const colour::Config& config = shot.colour.get();
+  return composite::composite(
+      inputs, paper, passes.width, passes.height,
+      [&](ImageView<float> rgb) { config.convert(rgb, "color_picking", "scene_linear"); });
 }
 
 namespace {

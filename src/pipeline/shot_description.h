@@ -4,9 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "colour/colour.h"
 #include "composite/composite.h"
 #include "exemplar/reference_sphere.h"
 #include "render/renderer.h"
@@ -62,6 +64,9 @@ struct Source {
   bool world_normals = false;  // normal is world-space (turned into camera space)
   bool z_up = false;           // position (and world normals) are Z-up
   bool premultiplied = false;  // continuous passes are premultiplied by alpha
+  // The colour space of the colour passes (albedo), converted to the config's scene_linear on
+  // reading; data passes (normals, positions, ids, motion) are never converted.
+  std::string passes_colorspace = "scene_linear";
 };
 
 enum class ExemplarKind {
@@ -76,6 +81,9 @@ struct Exemplar {
   exemplar::ReferenceSpec reference;  // kMatcap; width/height come from the painting
   int aa = 3;                         // kMatcap: supersampling of the reference passes
   std::string passes;                 // kKeyframe: multilayer EXR with emaki's channel names
+  // The painting's colour space (a name or role of the shot's config); it is converted to the
+  // config's color_picking space, the painter's values the synthesis sees.
+  std::string colorspace = "color_picking";
 };
 
 struct GuideSpec {
@@ -145,7 +153,16 @@ struct TemporalSpec {
   // not the leftovers of the carried field). Not in the shot file: measured defaults.
   int anchor = 2;
   float anchor_sigma = 4.0f;
+  // The share of the difference moved at each frame (1: all of it); below 1 the anchored tone
+  // follows the fresh transfers' as a running mean along the chain, which averages their noise.
+  float anchor_rate = 1.0f;
+  // Search-vote iterations at the fresh transfer's finest level (-1: the schedule's).
+  int anchor_finest_iters = -1;
   bool anchor_holes = true;
+  // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
+  // iterations in each.
+  int finest_iters = 1;
+  int warm_patch_match_iters = 2;
 };
 
 struct SynthSpec {
@@ -174,10 +191,35 @@ struct Layer {
   int order = 0;  // compositing order, bottom first; ties keep the file's order
 };
 
+// Where the layers are blended (compositing.space).
+enum class CompositingSpace {
+  kDisplay,      // on display-referred values (the config's color_picking space), as a painter's
+                 // layer stack in Krita or Photoshop: today's look, the default
+  kSceneLinear,  // each coloured layer and the paper turned scene-linear, then blended
+};
+
 struct Compositing {
   std::string paper;  // texture file; empty: flat paper_color
   float paper_scale = 1.0f;
   composite::Color paper_color{1.0f, 1.0f, 1.0f};
+  std::string paper_colorspace = "color_picking";  // the scan's colour space
+  CompositingSpace space = CompositingSpace::kDisplay;
+};
+
+// Colour management (colour/colour.h): the config every colour-space name of the shot is
+// looked up in, and the spaces that are not per exemplar. Names may be roles.
+struct Colour {
+  std::string config;  // colour.config, resolved; empty: none ($OCIO, else the built-in config)
+  std::shared_ptr<const colour::Config> ocio;  // opened by the parser; null: the built-in config
+  // PNG / MP4 previews and the contact sheet go through this display and view; empty: the
+  // config's default display and that display's default view.
+  std::string display, view;
+
+  const colour::Config& get() const { return ocio ? *ocio : *colour::Config::builtin(); }
+  // The space the composite is in: color_picking (display) or scene_linear.
+  std::string working_space(CompositingSpace space) const {
+    return space == CompositingSpace::kDisplay ? "color_picking" : "scene_linear";
+  }
 };
 
 struct Outputs {
@@ -199,6 +241,7 @@ struct Shot {
   std::vector<Exemplar> exemplars;
   std::vector<Layer> layers;  // in compositing order (bottom first)
   Compositing compositing;
+  Colour colour;
   Outputs outputs;
   int threads = 0;
   int64_t max_pixels = 0;  // limits.max_pixels; 0: none given (the process's budget applies)

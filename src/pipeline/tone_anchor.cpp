@@ -73,7 +73,7 @@ AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synt
 
 Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
                    const synth::Params& params, ImageView<const float> advected, int value_channels,
-                   const Image<float>& mask, float sigma) {
+                   const Image<float>& mask, float sigma, float rate) {
   const int halvings = exemplar.halvings;
   CHECK_EQ(exemplar.planes.size(), inputs.guides.size() + 1);
   // The small inputs, kept alive while the small transfer reads them.
@@ -137,7 +137,7 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
     for (int x = 0; x < advected.width; ++x)
       for (int c = 0; c < n; ++c) {
         const float d =
-            sample(smooth, (float(x) + 0.5f) * fx - 0.5f, (float(y) + 0.5f) * fy - 0.5f, c);
+            rate * sample(smooth, (float(x) + 0.5f) * fx - 0.5f, (float(y) + 0.5f) * fy - 0.5f, c);
         out(x, y, c) = std::clamp(advected(x, y, c) + d, 0.0f, 1.0f);
       }
   return a;

@@ -24,14 +24,14 @@ AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synt
 // for a whole-pyramid transfer (its seed included); `advected`: B'adv, value channels first;
 // `mask`: the layer's mask at the frame (empty: none). The fresh transfer runs with every input
 // halved exemplar.halvings times; the difference of the two, low-passed by `sigma` pixels at that
-// size and inside the mask, is added back at full size. Both members are empty when the frame or
-// the mask is too small to synthesize at that size.
+// size and inside the mask, is added back at full size, times `rate`. Both members are empty when
+// the frame or the mask is too small to synthesize at that size.
 struct Anchor {
   Image<float> target;  // the anchored B'adv (value channels)
   Image<int32_t> nnf;   // the fresh transfer's field scaled to full size ((-1, -1) outside it)
 };
 Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
                    const synth::Params& params, ImageView<const float> advected, int value_channels,
-                   const Image<float>& mask, float sigma);
+                   const Image<float>& mask, float sigma, float rate = 1.0f);
 
 }  // namespace emaki::pipeline

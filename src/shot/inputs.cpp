@@ -72,12 +72,37 @@ Image<float> rgb_of(const std::string& key, const std::string& path) {
       key, fmt::format("'{}' has {} channels; expected grey, RGB or RGBA", path, img.channels()));
 }
 
+// A studio render's frames with their albedo converted from source.passes_colorspace to the
+// config's scene_linear (what emaki's renderer writes); the data passes are left as they are.
+class ColourConvertedFrames : public pipeline::FrameSource {
+ public:
+  ColourConvertedFrames(const Shot& shot, std::unique_ptr<pipeline::FrameSource> inner)
+      : colour_(shot.colour), space_(shot.source.passes_colorspace), inner_(std::move(inner)) {}
+  Image<float> passes(int frame) const override {
+    Image<float> p = inner_->passes(frame);
+    ImageView<float> albedo = p.view();
+    albedo.data += render::kAlbedo;
+    albedo.channels = p.channels();  // the pixel step; convert() touches the first three
+    colour_.get().convert(albedo, space_, "scene_linear");
+    return p;
+  }
+
+ private:
+  const pipeline::Colour colour_;
+  const std::string space_;
+  std::unique_ptr<pipeline::FrameSource> inner_;
+};
+
 }  // namespace
 
 std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
   const pipeline::Source& s = shot.source;
   try {
-    if (s.kind == pipeline::SourceKind::kSequence) return io::open_sequence(s);
+    if (s.kind == pipeline::SourceKind::kSequence) {
+      std::unique_ptr<pipeline::FrameSource> frames = io::open_sequence(s);
+      if (shot.colour.get().is_identity(s.passes_colorspace, "scene_linear")) return frames;
+      return std::make_unique<ColourConvertedFrames>(shot, std::move(frames));
+    }
     return io::with_pass_cache(shot, pipeline::scene_frames(load_scene(s), s));
   } catch (const Error& e) {
     rethrow_as_key(e, "source");
@@ -91,6 +116,7 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
     const std::string key = "exemplars." + e.name;
     pipeline::ExemplarImages im;
     im.painting = rgb_of(key + ".painting", e.painting);
+    shot.colour.get().convert(im.painting.view(), e.colorspace, "color_picking");
     const int w = im.painting.width(), h = im.painting.height();
     if (e.kind == pipeline::ExemplarKind::kMatcap) {
       // Rendered once per shot: later tasks and runs read what the first one kept.
@@ -188,8 +214,10 @@ pipeline::WeightMapImages load_weight_maps(const Shot& shot) {
 
 pipeline::CompositeInputs load_composite_inputs(const Shot& shot) {
   pipeline::CompositeInputs ci;
-  if (!shot.compositing.paper.empty())
+  if (!shot.compositing.paper.empty()) {
     ci.paper = rgb_of("compositing.paper", shot.compositing.paper);
+    shot.colour.get().convert(ci.paper.view(), shot.compositing.paper_colorspace, "color_picking");
+  }
   return ci;
 }
 

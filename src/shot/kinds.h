@@ -29,6 +29,10 @@ inline constexpr Named<pipeline::SourcePreset> kSourcePresets[] = {
     {"emaki", pipeline::SourcePreset::kEmaki},
     {"blender", pipeline::SourcePreset::kBlender},
 };
+inline constexpr Named<pipeline::CompositingSpace> kCompositingSpaces[] = {
+    {"display", pipeline::CompositingSpace::kDisplay},
+    {"scene_linear", pipeline::CompositingSpace::kSceneLinear},
+};
 inline constexpr Named<pipeline::ExemplarKind> kExemplarKinds[] = {
     {"matcap", pipeline::ExemplarKind::kMatcap},
     {"keyframe", pipeline::ExemplarKind::kKeyframe},

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/shot_keys.h"
 #include "shot/parser_sections.h"
 
 namespace emaki::shot {
@@ -10,6 +11,7 @@ namespace emaki::shot {
 void parse_exemplar(const Reader& r, const PathContext& ctx, pipeline::Exemplar& e) {
   e.kind = r.choice("kind", e.kind, kExemplarKinds);
   e.painting = ctx.input_file(r, "painting", true);
+  e.colorspace = r.string(shot_keys::kColorspace, e.colorspace);
   if (e.kind == pipeline::ExemplarKind::kKeyframe) {
     for (const char* k : {"sphere", "elevation", "horizon", "fov", "light", "softness", "ground",
                           "ground_color", "aa"})

@@ -148,7 +148,8 @@ void parse_scene_source(const Reader& r, const PathContext& ctx, pipeline::Sourc
   }
   if (r.has("objects")) parse_objects(r, ctx, s);
   parse_light_and_ground(r, s.shot);
-  for (const char* k : {"channels", "preset", "view_layer", "normals", "up", "premultiplied"})
+  for (const char* k :
+       {"channels", "preset", "view_layer", "normals", "up", "premultiplied", "passes_colorspace"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'sequence' source only");
 }
 
@@ -247,6 +248,7 @@ void parse_sequence_source(const Reader& r, const PathContext& ctx, pipeline::So
   s.world_normals = r.choice("normals", s.world_normals, kNormalSpaces);
   s.z_up = r.choice("up", s.z_up, kUpAxes);
   s.premultiplied = r.boolean("premultiplied", s.premultiplied);
+  s.passes_colorspace = r.string("passes_colorspace", s.passes_colorspace);
   for (const char* k : {"clip", "start", "loop", "aa", "outline_width", "crease", "camera", "light",
                         "ground", "background", "size", "objects"})
     if (r.has(k)) throw Error(r.key_path(k), "applies to a 'scene' source only");

@@ -8,7 +8,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
+#include "colour/colour.h"
+#include "core/shot_keys.h"
 #include "io/input_file.h"
 #include "shot/parser_sections.h"
 
@@ -162,7 +165,8 @@ void parse_layers(const toml::table& layers, Shot& shot) {
                    [](const auto& a, const auto& b) { return a.order < b.order; });
 }
 
-void parse_outputs(const Reader& r, const PathContext& ctx, pipeline::Outputs& o) {
+void parse_outputs(const Reader& r, const PathContext& ctx, Shot& shot) {
+  pipeline::Outputs& o = shot.outputs;
   const std::string folder = r.string("folder", "");
   if (folder.empty()) throw Error("outputs.folder", "is required");
   o.folder = ctx.resolve(folder);
@@ -176,10 +180,30 @@ void parse_outputs(const Reader& r, const PathContext& ctx, pipeline::Outputs& o
                                     Switch{"contact_sheet", &pipeline::Outputs::contact_sheet}})
     o.*member = r.boolean(key, o.*member);
   o.crf = r.integer("crf", o.crf);
+  shot.colour.display = r.string("display", shot.colour.display);
+  shot.colour.view = r.string("view", shot.colour.view);
   if (o.mp4 && !o.composite_png)
     throw Error("outputs.mp4",
                 "is made from the composited PNG frames: needs composite_png = true");
   check_output_folder("outputs.folder", o.folder);
+}
+
+// The config opened and every colour-space, display and view name of the shot looked up in it,
+// before any frame runs; the display and view defaults filled in.
+void check_colour(Shot& shot) {
+  shot.colour.ocio = colour::Config::open(shot.colour.config, shot_keys::kColourConfig);
+  const colour::Config& c = *shot.colour.ocio;
+  for (const pipeline::Exemplar& e : shot.exemplars)
+    c.require_space(shot_keys::exemplar_key(echo(e.name), shot_keys::kColorspace), e.colorspace);
+  c.require_space(shot_keys::kPaperColorspace, shot.compositing.paper_colorspace);
+  if (shot.source.kind == pipeline::SourceKind::kSequence)
+    c.require_space(shot_keys::kPassesColorspace, shot.source.passes_colorspace);
+  // The working spaces are roles: a config without them cannot composite.
+  c.require_space(shot_keys::kCompositingSpace, "color_picking");
+  if (shot.compositing.space == pipeline::CompositingSpace::kSceneLinear)
+    c.require_space(shot_keys::kCompositingSpace, "scene_linear");
+  std::tie(shot.colour.display, shot.colour.view) = c.require_display_view(
+      shot_keys::kOutputsDisplay, shot.colour.display, shot_keys::kOutputsView, shot.colour.view);
 }
 
 toml::table parse_toml(std::string_view text, const std::string& path) {
@@ -210,6 +234,10 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     if (r.has("max_pixels")) shot.max_pixels = r.integer64("max_pixels", 0);
   }
   const ScopedMaxPixels budget(shot_max_pixels(shot.max_pixels));
+  if (const toml::table* t = top.table("colour")) {
+    const Reader r(*t, "colour", "colour");
+    shot.colour.config = ctx.input_file(r, "config", false);
+  }
   parse_source(Reader(*top.table("source", true), "source", "source"), ctx, shot.source);
   parse_exemplars(*top.table("exemplars", true), ctx, shot);
   parse_layers(*top.table("layers", true), shot);
@@ -218,8 +246,12 @@ Shot parse_shot(std::string_view text, const std::string& path) {
     shot.compositing.paper = ctx.input_file(r, "paper", false);
     shot.compositing.paper_scale = r.real("paper_scale", shot.compositing.paper_scale);
     shot.compositing.paper_color = r.color("paper_color", shot.compositing.paper_color);
+    shot.compositing.paper_colorspace =
+        r.string("paper_colorspace", shot.compositing.paper_colorspace);
+    shot.compositing.space = r.choice("space", shot.compositing.space, kCompositingSpaces);
   }
-  parse_outputs(Reader(*top.table("outputs", true), "outputs", "outputs"), ctx, shot.outputs);
+  parse_outputs(Reader(*top.table("outputs", true), "outputs", "outputs"), ctx, shot);
+  check_colour(shot);
   return shot;
 }
 

@@ -21,6 +21,8 @@ constexpr double kTwoPow40 = 1099511627776.0;
 constexpr KeySpec kSchema[] = {
     {.key = "threads", .type = "integer", .default_value = "`0`", .lo = 0, .hi = 1024, .meaning = "worker threads, 0 = all cores (results do not depend on it)"},
     {.key = "limits.max_pixels", .type = "integer", .default_value = "`268435456` (2^28)", .lo = 1, .hi = kTwoPow40, .range = "[1, 2^40]", .meaning = "the pixel budget: no image emaki reads or makes (frames, paintings, passes, paper) may hold more pixels; `source.size` is checked against it when the shot loads. `--max-pixels N` on the command line wins over it. See [Limits](#limits)"},
+    {.key = "colour", .type = "table", .default_value = "—", .meaning = "colour management (OpenColorIO): the config the shot's colour-space, display and view names are looked up in. See [Colour management](#colour-management)"},
+    {.key = "colour.config", .type = "string (path)", .default_value = "emaki's built-in config", .meaning = "an OpenColorIO config (`.ocio`), e.g. Blender's `datafiles/colormanagement/config.ocio`; `$OCIO`, when set, wins over it. The built-in config: `scene-linear Rec.709` (reference), `ACEScg`, `sRGB texture`, `raw`; display `sRGB` with views `Standard`, `Filmic`, `Raw`"},
     {.key = "source", .type = "table", .default_value = "required", .meaning = "where each frame's guide passes come from: exactly one of `scene`, `objects` or `sequence`"},
     {.key = "source.scene", .type = "string (path)", .default_value = "—", .meaning = "a glTF 2.0 `.gltf`/`.glb` rendered by emaki's renderer"},
     {.key = "source.objects", .type = "array of tables", .default_value = "—", .meaning = "instead of `scene`: a scene assembled from glTF assets, one `[[source.objects]]` table each, under the shot's camera, light and ground; each object plays its own clip (`source.clip`, `start`, `loop` and `camera.mode = \"gltf\"` are refused). See [Assembled scenes](#assembled-scenes-sourceobjects)"},
@@ -70,6 +72,7 @@ constexpr KeySpec kSchema[] = {
     {.key = "source.channels.PASS", .type = "[string, ...]", .default_value = "the preset's", .meaning = "sequence: the file's channel names for a pass (as many as the pass has), e.g. `normal = [\"N.X\", \"N.Y\", \"N.Z\"]`, read over the preset's; every channel must be in the first frame"},
     {.key = "source.normals", .type = "string", .default_value = "`\"camera\"`", .meaning = "sequence, `emaki`: `world` if the file's normals are world-space (turned into camera space with the camera fitted to the position pass)"},
     {.key = "source.up", .type = "string", .default_value = "`\"y\"`", .meaning = "sequence, `emaki`: `z` if position (and world normals) are Z-up: (x, y, z) becomes (x, z, -y)"},
+    {.key = "source.passes_colorspace", .type = "string", .default_value = "`\"scene_linear\"` (role)", .meaning = "sequence: the colour space of the render's albedo, converted to the config's `scene_linear` on reading (e.g. `\"ACEScg\"`); data passes (normals, positions, depth, ids, motion, masks) are never converted"},
     {.key = "source.premultiplied", .type = "boolean", .default_value = "`false`", .meaning = "sequence, `emaki`: the continuous passes are premultiplied by alpha (divided by it on reading)"},
     {.key = "exemplars.NAME", .type = "table", .default_value = "at least one", .meaning = "a painting and the guides it was painted over"},
     {.key = "exemplars.NAME.kind", .type = "string", .default_value = "`\"matcap\"`", .meaning = "`matcap`: a painted sphere, its guides are the reference sphere's passes fitted to it (as `emaki template --fit`); `keyframe`: a painted frame with its pass file"},
@@ -83,6 +86,7 @@ constexpr KeySpec kSchema[] = {
     {.key = "exemplars.NAME.ground", .type = "boolean", .default_value = "`true`", .meaning = "matcap: the sphere stands on a ground plane (and casts a shadow on it)"},
     {.key = "exemplars.NAME.ground_color", .type = "[r, g, b]", .default_value = "`[0.8, 0.8, 0.8]`", .range = "each in [0, 1]", .meaning = "matcap: ground albedo"},
     {.key = "exemplars.NAME.aa", .type = "integer", .default_value = "`3`", .lo = 1, .hi = 4, .meaning = "matcap: supersampling of the reference passes"},
+    {.key = "exemplars.NAME.colorspace", .type = "string", .default_value = "`\"color_picking\"` (role; built-in: `sRGB texture`)", .meaning = "the painting's colour space, converted to the config's `color_picking` space (display-referred values, what the synthesis and the layer colours work on)"},
     {.key = "exemplars.NAME.passes", .type = "string (path)", .default_value = "required (keyframe)", .meaning = "keyframe: multilayer EXR with emaki's channel names, the painting's size; must hold every pass its layers use as guides"},
     {.key = "layers.NAME", .type = "table", .default_value = "at least one", .meaning = "one stylized layer; `kind` sets the defaults marked *kind*"},
     {.key = "layers.NAME.kind", .type = "string", .default_value = "`\"custom\"`", .meaning = "`base` (guides normal 1 + diffuse 1, mask `covered`, colour `albedo`), `shadow` (guides diffuse 1 + shadow 1, mask `shadow` dilated 2 px, flat lilac, `multiply`), `outline` (guides outline 2 + normal 0.5, mask `lines` (threshold 0.1) dilated 3 px, dark ink, alpha `inverse_value`); `shadow` and `outline` also set `temporal_weight = 0` and `temporal_uniformity = 0`, `custom` (guides required, no mask, flat white)"},
@@ -123,6 +127,8 @@ constexpr KeySpec kSchema[] = {
     {.key = "compositing.paper", .type = "string (path)", .default_value = "—", .meaning = "a paper/canvas scan, tiled from the top-left corner; none: flat `paper_color`"},
     {.key = "compositing.paper_scale", .type = "number", .default_value = "`1`", .lo = 0.01, .hi = 100, .meaning = "output pixels per paper pixel"},
     {.key = "compositing.paper_color", .type = "[r, g, b]", .default_value = "`[1, 1, 1]`", .range = "each in [0, 1]", .meaning = "multiplies the paper (or is the paper)"},
+    {.key = "compositing.paper_colorspace", .type = "string", .default_value = "`\"color_picking\"` (role; built-in: `sRGB texture`)", .meaning = "the paper scan's colour space, converted to `color_picking`"},
+    {.key = "compositing.space", .type = "string", .default_value = "`\"display\"`", .meaning = "where the layers are blended: `display` (on display-referred `color_picking` values, as a painter's layer stack in Krita or Photoshop) or `scene_linear` (each coloured layer and the paper converted to `scene_linear`, then blended: the composite EXRs are scene-linear, for a comp in Nuke). Colours in the shot file are `color_picking` values in both. See [Colour management](#colour-management)"},
     {.key = "outputs", .type = "table", .default_value = "required", .meaning = "what is written, under `folder`"},
     {.key = "outputs.folder", .type = "string (path)", .default_value = "required", .meaning = "output folder (created; must be writable). Always written: `layers/NAME/NAME_%04d.exr` (float touch + mask coverage; resuming and `emaki composite` read them)"},
     {.key = "outputs.layer_png", .type = "boolean", .default_value = "`true`", .meaning = "`layers/NAME/NAME_%04d.png`, 16-bit grey + alpha"},
@@ -131,6 +137,8 @@ constexpr KeySpec kSchema[] = {
     {.key = "outputs.layered_exr", .type = "boolean", .default_value = "`true`", .meaning = "`layered/frame_%04d.exr`: every pass, every layer (`layer_NAME.Y`, `layer_NAME.A`; `.R/.G/.B` for a colour layer) and the composite (`composite.R/G/B`), half, for Nuke / After Effects"},
     {.key = "outputs.mp4", .type = "boolean", .default_value = "`true`", .meaning = "`preview.mp4` (ffmpeg, libx264) from the composited PNGs; needs `composite_png`"},
     {.key = "outputs.contact_sheet", .type = "boolean", .default_value = "`true`", .meaning = "`contact_sheet.png`: up to 12 composited frames spread over the shot"},
+    {.key = "outputs.display", .type = "string", .default_value = "the config's default (built-in: sRGB)", .meaning = "the display the composited PNGs (and so `preview.mp4` and the contact sheet) are made for"},
+    {.key = "outputs.view", .type = "string", .default_value = "the display's default (built-in: Standard)", .meaning = "the view of `display`: built-in `Standard` (the sRGB curve), `Filmic` (a filmic tone scale, ACES 1.0 SDR) or `Raw`"},
     {.key = "outputs.crf", .type = "integer", .default_value = "`20`", .lo = 0, .hi = 51, .meaning = "libx264 quality, lower is better"},
 };
 // clang-format on

@@ -52,8 +52,9 @@ TEST(Schema, KeysAreUniqueAndUnderTheirTables) {
       EXPECT_LE(k.lo, k.hi) << k.key;
     }
   }
-  EXPECT_EQ(child_keys(""), (std::vector<std::string>{"threads", "limits", "source", "exemplars",
-                                                      "layers", "compositing", "outputs"}));
+  EXPECT_EQ(child_keys(""),
+            (std::vector<std::string>{"threads", "limits", "colour", "source", "exemplars",
+                                      "layers", "compositing", "outputs"}));
   EXPECT_EQ(child_keys("source.light"),
             (std::vector<std::string>{"direction", "world", "softness", "turn"}));
   EXPECT_NE(find_key("layers.NAME.guides.PASS"), nullptr);
@@ -66,8 +67,10 @@ TEST(Schema, KeysSpelledOutsideTheShotModuleAreInIt) {
   for (const std::string& key :
        {layer("NAME"), layer_key("NAME", kSingleColour), layer_key("NAME", kTemporal),
         layer_key("NAME", kColor), layer_key("NAME", kGradient), layer_guide("NAME", "PASS"),
-        exemplar_key("NAME", kPainting), std::string(kPaperScale), std::string(kOutputsFolder),
-        std::string(kOutputsMp4)})
+        exemplar_key("NAME", kPainting), exemplar_key("NAME", kColorspace),
+        std::string(kPaperScale), std::string(kOutputsFolder), std::string(kOutputsMp4),
+        std::string(kColourConfig), std::string(kPassesColorspace), std::string(kPaperColorspace),
+        std::string(kCompositingSpace), std::string(kOutputsDisplay), std::string(kOutputsView)})
     EXPECT_NE(find_key(key), nullptr) << key;
   for (const FieldKey& k : kFieldKeys) {
     const std::string section = k.section;

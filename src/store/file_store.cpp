@@ -348,6 +348,21 @@ bool FileStore::has_frame(int frame) const {
   return true;
 }
 
+std::string FileStore::working_space() const {
+  return shot_.colour.get().resolve(shot_.colour.working_space(shot_.compositing.space));
+}
+
+// The composite EXRs are in the working space: its name and chromaticities in the header
+// (docs/shot_file.md, "What a compositor gets").
+WriteOptions FileStore::exr_options() const {
+  WriteOptions wo;
+  wo.format = SampleFormat::kHalf;
+  const std::string space = working_space();
+  wo.attributes = {{"colorSpace", space}};
+  wo.chromaticities = shot_.colour.get().chromaticities(space);
+  return wo;
+}
+
 void FileStore::write_frame(int frame, ImageView<const float> composite,
                             const std::vector<ImageView<const float>>& layers,
                             ImageView<const float> passes) {
@@ -387,18 +402,16 @@ void FileStore::write_frame(int frame, ImageView<const float> composite,
         }
       }
     });
-    WriteOptions wo;
-    wo.format = SampleFormat::kHalf;
+    WriteOptions wo = exr_options();
     wo.channel_names = names;
     write_image(paths_.layered_exr(frame), all.cview(), wo);
   }
-  if (o.composite_exr) {
-    WriteOptions wo;
-    wo.format = SampleFormat::kHalf;
-    write_image(paths_.composite_exr(frame), rgb.cview(), wo);
-  }
-  // The PNG last: with the default outputs it is what has_frame looks for first.
+  if (o.composite_exr) write_image(paths_.composite_exr(frame), rgb.cview(), exr_options());
+  // The PNG last: with the default outputs it is what has_frame looks for first. It goes
+  // through the display and view (nothing changes when the view writes the working space).
   if (o.composite_png) {
+    shot_.colour.get().to_display(rgb.view(), working_space(), shot_.colour.display,
+                                  shot_.colour.view);
     WriteOptions wo;
     wo.format = SampleFormat::kU16;
     write_image(paths_.composite_png(frame), rgb.cview(), wo);

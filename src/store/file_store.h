@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "io/image_io.h"
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "pipeline/shot_description.h"
@@ -94,6 +95,9 @@ class FileStore : public pipeline::Store {
   const OutputPaths& paths() const { return paths_; }
 
  private:
+  // The composite's colour space (colour.h): color_picking or scene_linear, resolved.
+  std::string working_space() const;
+  WriteOptions exr_options() const;
   struct Manifested {
     Manifest want;         // the settings of the shot as it is now
     bool current = false;  // the files on disk were made with them

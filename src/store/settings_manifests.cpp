@@ -102,6 +102,8 @@ void add_source(Lines& l, const pipeline::Shot& shot) {
           fmt::format("{} {} world_normals {} z_up {} premultiplied {}",
                       s.preset == pipeline::SourcePreset::kBlender ? "blender" : "emaki",
                       s.view_layer, s.world_normals, s.z_up, s.premultiplied));
+    if (s.passes_colorspace != pipeline::Source{}.passes_colorspace)
+      l.add("source.passes_colorspace", s.passes_colorspace);
     for (const pipeline::ChannelMapping& m : s.channels)
       l.add("source.channels." + m.pass, fmt::format("{}", fmt::join(m.channels, " ")));
   }
@@ -123,6 +125,8 @@ void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
   l.add(p + "kind", int(e.kind));
   l.add(p + "painting", canonical(e.painting));
   l.add(p + "painting.digest", file_digest(e.painting));
+  // Only when not the default, so that outputs made before the key existed stay current.
+  if (e.colorspace != pipeline::Exemplar{}.colorspace) l.add(p + "colorspace", e.colorspace);
   if (e.kind == pipeline::ExemplarKind::kMatcap) {
     add_reference(l, p, e);
   } else {
@@ -140,6 +144,7 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
   add_source(l, shot);
   const std::string p = "layers." + layer.name + ".";
   l.add(p + "exemplar", layer.exemplar);
+  if (!shot.colour.config.empty()) l.add("colour.config", canonical(shot.colour.config));
   if (const pipeline::Exemplar* e = shot.find_exemplar(layer.exemplar)) add_exemplar(l, *e);
   for (const pipeline::GuideSpec& g : layer.guides) {
     l.add(p + "guides." + g.pass, g.weight);
@@ -164,6 +169,13 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
       p + "temporal.confidence",
       fmt::format("{} error {} {} foreign {} erode {} uniformity {}", layer.temporal.confidence,
                   c.error_full, c.error_none, c.foreign_none, c.erode, layer.temporal.uniformity));
+  const pipeline::TemporalSpec& t = layer.temporal;
+  l.add(p + "temporal.chain",
+        fmt::format("guide_sigma {} reseed {} change {} {} anchor {} sigma {} rate {} holes {} "
+                    "finest {} schedule {} {}",
+                    t.guide_sigma, t.reseed, c.change_full, c.change_none, t.anchor, t.anchor_sigma,
+                    t.anchor_rate, t.anchor_holes, t.anchor_finest_iters, t.finest_iters,
+                    t.warm_patch_match_iters));
   l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
                                 layer.mask.dilate, layer.mask.threshold));
   return l.m;

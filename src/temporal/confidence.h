@@ -55,7 +55,9 @@ struct ConfidenceParams {
   float change_none = 0.0f;
   // Shrink the confident region by this many pixels, so that patches centred next to an
   // untrusted pixel do not carry it either (the weight map applies at patch centres); 0: none.
-  int erode = 1;
+  // 2, the radius of the default 5 x 5 patch: no patch over an uncovered pixel carries the
+  // guide (docs/design/temporal-confidence.md).
+  int erode = 2;
 };
 
 // visible x the foreign ramp x the error ramp (x the change ramp, with `change`), eroded. `error`:

@@ -73,3 +73,18 @@ mp4 = false
 TOML
 run "$EMAKI" run "$WORK/shot.toml"
 "$CHECK" outputs "$WORK/out" 1 4 base shadow outline
+
+# colour.toml: Blender's config, display and view as shot keys, which emaki accepts (Blender's
+# config, its default Filmic view on the previews).
+for key in config display view passes_colorspace; do
+  grep -q "^$key = " "$WORK/renders/colour.toml" ||
+    { cat "$WORK/renders/colour.toml"; echo "FAIL: colour.toml has no $key"; exit 1; }
+done
+{
+  sed -n '/^\[colour\]/,/^$/p' "$WORK/renders/colour.toml"
+  sed 's/^folder = "out"/folder = "out_colour"/' "$WORK/shot.toml"
+  sed -n '/^\[outputs\]/,$p' "$WORK/renders/colour.toml" | grep -E '^(display|view) = '
+} >"$WORK/shot_colour.toml"
+run "$EMAKI" run "$WORK/shot_colour.toml" --frames 1
+[ -f "$WORK/out_colour/composite/frame_0001.png" ] ||
+  { echo "FAIL: the shot with Blender's colour settings wrote no composite"; exit 1; }

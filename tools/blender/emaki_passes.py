@@ -28,9 +28,12 @@
 #   motion: Cycles' Vector pass (pixels from here to the previous position, x right, y up)
 #     with y turned down, as emaki's.
 #   alpha: the film's alpha with a transparent background.
+# Beside the frames, colour.toml: the scene's colour management (the OpenColorIO config Blender
+# runs with, its display and view) as shot-file keys (docs/blender.md).
 # Single-channel passes come out as NAME.V (the File Output node's name for a value socket);
 # emaki's `emaki` channel preset reads NAME.V as well as emaki's own NAME.Y / .Z / .A.
 
+import json
 import math
 import os
 import sys
@@ -544,6 +547,48 @@ def setup(scene, out_base, frames, size, samples, light, light_world, softness, 
             "light": list(to_yup(direction))}
 
 
+def blender_ocio_config():
+    """The OpenColorIO config this Blender runs with: $OCIO, else its own datafiles."""
+    env = os.environ.get("OCIO")
+    if env:
+        return env
+    for kind in ("LOCAL", "SYSTEM"):
+        path = os.path.join(bpy.utils.resource_path(kind), "datafiles", "colormanagement",
+                            "config.ocio")
+        if os.path.isfile(path):
+            return path
+    return None
+
+
+def toml_string(text):
+    # A TOML basic string: JSON's escapes are TOML's (json.dumps writes no "\/").
+    return json.dumps(text, ensure_ascii=False)
+
+
+def write_colour_settings(scene, out_dir):
+    """colour.toml: the scene's colour management as shot-file keys. The passes are written
+    scene-linear (EXR ignores the view), which the shot's default source.passes_colorspace
+    already says; the previews are to look as Blender shows the scene."""
+    config = blender_ocio_config()
+    lines = ["# The colour management of Blender's scene '%s', as emaki's shot keys: copy them into"
+             % scene.name.replace("\n", " "),
+             "# the shot file's tables of the same names (docs/shot_file.md#colour-management).",
+             ""]
+    if config:
+        lines += ["[colour]", "config = %s" % toml_string(os.path.abspath(config)), ""]
+    lines += ["[source]", 'passes_colorspace = "scene_linear"', "",
+              "[outputs]",
+              "display = %s" % toml_string(scene.display_settings.display_device),
+              "view = %s" % toml_string(scene.view_settings.view_transform)]
+    if scene.view_settings.look not in ("", "None"):
+        lines.append("# Blender's look '%s' has no shot key: emaki applies no look." %
+                     scene.view_settings.look.replace("\n", " "))
+    path = os.path.join(out_dir, "colour.toml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")
+    print("emaki: wrote %s" % path, flush=True)
+
+
 def render_frames(scene, out_dir, frames):
     written = []
     for f in frames:
@@ -762,6 +807,7 @@ def main(argv):
     info = setup(scene, os.path.join(out, "frame_"), frames, size, args.samples, light,
                  args.light_world, args.softness, args.ground)
     render_frames(scene, out, frames)
+    write_colour_settings(scene, out)
     print("emaki: box %s, rest box %s, light %s" % (info["box"], info["rest_box"], info["light"]))
 
 
