@@ -166,6 +166,21 @@ class Shot:
     def flicker(self, layer: str, *, frames: Union[None, int, Tuple[int, int]] = None) -> dict: ...
     def plan(self, *, chunk: int = 8, threads: int = 1, emaki: str = "emaki") -> dict: ...
 
+class Viewer:
+    url: str
+    port: int
+    def stop(self) -> None: ...
+    def __enter__(self) -> "Viewer": ...
+    def __exit__(self, *args: object) -> None: ...
+
+def view(
+    folder: Union[str, os.PathLike],
+    folder_b: Union[None, str, os.PathLike] = None,
+    *,
+    port: int = 0,
+    bind: str = "127.0.0.1",
+) -> Viewer: ...
+
 pass_names: list[str]  # the passes render() and template() return, in channel order
 pass_channels: dict[str, list[str]]  # their EXR channel names: {'normal': ['normal.X', ...], ...}
 

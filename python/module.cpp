@@ -17,6 +17,7 @@ PYBIND11_MODULE(emaki, m) {
       "render()  guide passes of a glTF scene at one frame (as `emaki render`)\n"
       "template()  the reference sphere's passes and paint template (as `emaki template`)\n"
       "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
+      "view()  the page of output folders (as `emaki view`)\n"
       "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
   m.attr("__version__") = emaki::version();
   // The one performance switch (core/performance.h), as the command line applies it: huge-page
@@ -31,4 +32,5 @@ PYBIND11_MODULE(emaki, m) {
   bind_images(m);
   bind_render(m);
   bind_shot(m);
+  bind_view(m);
 }

@@ -18,6 +18,8 @@ int run_qa(const Args& args);
 int run_plan(const Args& args);
 int run_farm(const Args& args);
 int run_task(const Args& args);
+int run_view(const Args& args);
+int run_lookdev(const Args& args);
 int run_version(const Args& args);
 
 struct Command {

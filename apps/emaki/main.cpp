@@ -28,6 +28,9 @@ const std::vector<Command>& commands() {
       {"plan", "shots as a task graph for a render farm (a table, or --json)", run_plan},
       {"farm", "run shots on Slurm: 'emaki farm submit|status|cancel SHOT...'", run_farm},
       {"task", "one task of a plan, as a farm node runs it", run_task},
+      {"view", "a local page of output folders: player, layers, A/B wipe, manifests", run_view},
+      {"lookdev", "a few preview frames made again on every save of the painting, on a page",
+       run_lookdev},
       {"version", "the version: the release, and the git revision when built from a checkout",
        run_version},
   };
@@ -58,6 +61,7 @@ constexpr FieldOption kFieldOptions[] = {
     {"layers", "--layers"}, {"layer", "--layer"},
     {"chunk", "--chunk"},   {"threads", "--threads"},
     {"shots", "SHOT"},      {"max_memory", "--max-memory"},
+    {"port", "--port"},
 };
 
 // An emaki::Error naming a field is re-spelled as its option; anything else reads as it is.

@@ -11,7 +11,7 @@ import emaki
 
 STUB = pathlib.Path(__file__).resolve().parents[1] / "emaki.pyi"
 FUNCTIONS = ["synthesize", "read_image", "write_image", "image_channels", "render", "template",
-             "convert_colorspace"]
+             "convert_colorspace", "view"]
 
 
 def signature(fn_def):
@@ -40,7 +40,8 @@ def test_docstring_signature_agrees_with_the_stub(name):
     assert signature(parsed) == stub_functions()[name]
 
 
-@pytest.mark.parametrize("name", ["synthesize", "render", "template", "read_image", "write_image"])
+@pytest.mark.parametrize("name", ["synthesize", "render", "template", "read_image", "write_image",
+                                  "view"])
 def test_every_argument_is_documented(name):
     text = pydoc.render_doc(getattr(emaki, name))
     args = text.split("Args:")[1].split("Returns:")[0] if "Returns:" in text else text.split("Args:")[1]

@@ -1,0 +1,89 @@
+#include "view/rerun.h"
+
+#include <sys/stat.h>
+
+namespace emaki::view {
+
+namespace fs = std::filesystem;
+
+Rerun::Rerun(std::vector<fs::path> files, std::function<void(const std::atomic<bool>&)> work,
+             RerunOptions options)
+    : m_files(std::move(files)), m_work(std::move(work)), m_options(options) {}
+
+Rerun::~Rerun() {
+  stop();
+}
+
+void Rerun::start() {
+  m_watcher = std::thread([this] { watch(); });
+  m_runner = std::thread([this] { run_loop(); });
+}
+
+void Rerun::stop() {
+  {
+    std::lock_guard lock(m_mutex);
+    m_stopping = true;
+  }
+  m_stale = true;
+  m_wake.notify_all();
+  if (m_watcher.joinable()) m_watcher.join();
+  if (m_runner.joinable()) m_runner.join();
+}
+
+// Modification time (ns), size and inode of each file; a missing file reads as zeros (an editor
+// between its delete and its rename).
+std::string Rerun::stamps() const {
+  std::string s;
+  for (const fs::path& f : m_files) {
+    struct stat st {};
+    if (::stat(f.c_str(), &st) != 0) st = {};
+    s += std::to_string(st.st_mtim.tv_sec) + "." + std::to_string(st.st_mtim.tv_nsec) + ":" +
+         std::to_string(st.st_size) + ":" + std::to_string(st.st_ino) + ";";
+  }
+  return s;
+}
+
+void Rerun::watch() {
+  std::string seen = stamps();
+  std::unique_lock lock(m_mutex);
+  while (!m_stopping) {
+    m_wake.wait_for(lock, m_options.poll, [&] { return m_stopping; });
+    if (m_stopping) break;
+    lock.unlock();
+    std::string now = stamps();
+    lock.lock();
+    if (now == seen) continue;
+    seen = std::move(now);
+    ++m_saves;
+    m_pending = true;
+    m_last_save = std::chrono::steady_clock::now();
+    if (m_running) m_stale = true;
+    m_wake.notify_all();
+  }
+}
+
+void Rerun::run_loop() {
+  std::unique_lock lock(m_mutex);
+  while (!m_stopping) {
+    const auto due = m_last_save + m_options.settle;
+    if (!m_pending) {
+      m_wake.wait(lock);
+      continue;
+    }
+    if (std::chrono::steady_clock::now() < due) {
+      m_wake.wait_until(lock, due);
+      continue;
+    }
+    m_pending = false;
+    m_stale = false;
+    m_running = true;
+    ++m_started;
+    lock.unlock();
+    m_work(m_stale);
+    lock.lock();
+    m_running = false;
+    ++m_finished;
+  }
+}
+
+}  // namespace emaki::view

@@ -1,0 +1,49 @@
+#!/bin/sh
+# emaki lookdev end to end: a small Fox shot (96x54, --scale 1), a first run, then a burst of
+# ten saves of the painting 50 ms apart. The frame on the page must change (the status's
+# generation moves on, the composite file is rewritten) and the burst must start at most two
+# runs (finished ones, plus any stopped by a newer save). Exit 77 (skip) without curl.
+#   sh lookdev_test.sh SOURCE_DIR EMAKI WORK
+set -e
+src=$1 emaki=$2 work=$3
+command -v curl >/dev/null || { echo "skip: curl is not installed"; exit 77; }
+rm -rf "$work" && mkdir -p "$work"
+cp "$src/examples/stylit/source_style.png" "$work/painting.png"
+sed -e "s#\"../data/#\"$src/examples/data/#; s#\"../stylit/source_style.png\"#\"painting.png\"#" \
+    -e "s#size = \[960, 540\]#size = [96, 54]#" "$src/examples/fox/shot.toml" > "$work/shot.toml"
+port=$((20000 + $$ % 20000))
+"$emaki" lookdev "$work/shot.toml" --frames 0 --scale 1 --port "$port" > "$work/url" 2> "$work/log" &
+pid=$!
+trap 'kill $pid 2>/dev/null || true' EXIT
+status() { curl -s "http://127.0.0.1:$port/api/status" || true; }
+wait_for() {
+  i=0
+  while ! status | grep -q "$1"; do
+    i=$((i + 1))
+    [ $i -lt 3000 ] || { echo "FAIL: no '$1' within 300 s"; cat "$work/log"; exit 1; }
+    kill -0 $pid 2>/dev/null || { echo "FAIL: lookdev stopped"; cat "$work/log"; exit 1; }
+    sleep 0.1
+  done
+}
+wait_for '"generation":1,'
+grep -q '^http://127.0.0.1:' "$work/url" || { echo "FAIL: no URL printed"; exit 1; }
+frame="$work/out.lookdev/composite/frame_0000.png"
+[ -f "$frame" ] || { echo "FAIL: no preview frame"; exit 1; }
+before=$(stat -c %Y.%y "$frame")
+runs_before=$(grep -c -e ': run [0-9]*:' -e 'starting over' "$work/log" || true)
+i=0
+while [ $i -lt 10 ]; do
+  cp "$work/painting.png" "$work/painting.tmp.png" && mv "$work/painting.tmp.png" "$work/painting.png"
+  sleep 0.05
+  i=$((i + 1))
+done
+wait_for '"generation":2,'
+sleep 3  # anything the burst would still start shows within this time
+runs=$(( $(grep -c -e ': run [0-9]*:' -e 'starting over' "$work/log") - runs_before ))
+after=$(stat -c %Y.%y "$frame")
+echo "burst of 10 saves: $runs runs; generation $(status)"
+[ "$before" != "$after" ] || { echo "FAIL: the preview frame was not made again"; exit 1; }
+[ $runs -ge 1 ] && [ $runs -le 2 ] || { echo "FAIL: $runs runs for one burst"; cat "$work/log"; exit 1; }
+kill $pid && wait $pid || { echo "FAIL: lookdev did not stop cleanly on SIGTERM"; exit 1; }
+trap - EXIT
+echo "ok"

@@ -1,0 +1,182 @@
+// emaki view's page in Debian's headless Chromium: the binary serves small output folders (the
+// layout `emaki run` writes: composite/, layers/NAME/, manifests, contact sheet), Chromium loads
+// the page at a frame and layer named in the URL's hash, and the DOM (frame number, layer names,
+// manifest) and a screenshot (against the frame's own pixels, and an A/B wipe) are checked.
+// Skipped when chromium is not installed (scripts/setup.sh installs it).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/image.h"
+#include "io/image_io.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The browser: EMAKI_CHROMIUM when set (a path that is not executable skips the tests),
+// else Debian's.
+const char* chromium() {
+  const char* env = std::getenv("EMAKI_CHROMIUM");
+  const char* path = env && *env ? env : "/usr/bin/chromium";
+  return ::access(path, X_OK) == 0 ? path : nullptr;
+}
+
+// Frame `frame` of output `ab` (0: A, 1: B): flat quadrants whose colours depend on both, so a
+// screenshot of one frame cannot match another.
+emaki::Image<float> frame_image(int frame, int ab) {
+  emaki::Image<float> img(64, 48, 3);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const int q = (x >= 32) + 2 * (y >= 24);
+      img(x, y, 0) = float((40 * q + 60 * frame) % 256) / 255.f;
+      img(x, y, 1) = float(ab ? 200 : 30) / 255.f;
+      img(x, y, 2) = float((255 - 50 * q - 30 * frame) % 256) / 255.f;
+    }
+  return img;
+}
+
+void write_output(const fs::path& dir, int ab) {
+  fs::create_directories(dir / "composite");
+  for (const char* layer : {"base", "shadow"}) fs::create_directories(dir / "layers" / layer);
+  for (int f = 0; f < 3; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04d.png", f);
+    emaki::io::write_image((dir / "composite" / name).string(), frame_image(f, ab).cview());
+    for (const char* layer : {"base", "shadow"}) {
+      std::snprintf(name, sizeof name, "%s_%04d.png", layer, f);
+      emaki::io::write_image((dir / "layers" / layer / name).string(),
+                             frame_image(f + 5, ab).cview());
+    }
+  }
+  emaki::io::write_image((dir / "contact_sheet.png").string(), frame_image(0, ab).cview());
+  std::ofstream(dir / "composite" / ".emaki-manifest")
+      << "outputs_format = 1\nemaki_version = browser-test-" << ab << "\n";
+}
+
+class ViewBrowser : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!chromium()) GTEST_SKIP() << "chromium is not installed (scripts/setup.sh installs it)";
+    base = fs::temp_directory_path() / ("emaki_view_browser_" + std::to_string(::getpid()));
+    fs::remove_all(base);
+    write_output(base / "a", 0);
+    write_output(base / "b", 1);
+  }
+  void TearDown() override {
+    if (pid > 0) {
+      ::kill(pid, SIGTERM);
+      int status = 0;
+      ::waitpid(pid, &status, 0);
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "emaki view did not stop";
+    }
+    fs::remove_all(base);
+  }
+
+  // Starts `emaki view` on the folders and reads the URL it prints.
+  void serve(std::vector<std::string> folders) {
+    int out[2];
+    ASSERT_EQ(::pipe(out), 0);
+    pid = ::fork();
+    if (pid == 0) {
+      ::dup2(out[1], 1);
+      ::close(out[0]);
+      std::vector<char*> argv{const_cast<char*>(EMAKI_BINARY), const_cast<char*>("view")};
+      for (auto& f : folders) argv.push_back(f.data());
+      argv.push_back(nullptr);
+      ::execv(EMAKI_BINARY, argv.data());
+      ::_exit(127);
+    }
+    ::close(out[1]);
+    char c;
+    while (::read(out[0], &c, 1) == 1 && c != '\n') url += c;
+    ::close(out[0]);
+    ASSERT_EQ(url.rfind("http://127.0.0.1:", 0), 0u) << url;
+  }
+
+  // Chromium's output for the page at `hash`: the DOM (--dump-dom) or a screenshot file.
+  std::string browse(const std::string& hash, const std::string& mode) {
+    const fs::path profile = base / ("profile_" + std::to_string(++runs));
+    const fs::path out = base / ("out_" + std::to_string(runs));
+    // --no-sandbox: CI runs as root, where Chromium's sandbox refuses to start. The page polls
+    // its listing once at load; 4 s of virtual time lets it fetch and draw.
+    std::string command = std::string("timeout 120 ") + chromium() +
+                          " --headless --no-sandbox --disable-gpu --hide-scrollbars"
+                          " --force-device-scale-factor=1 --window-size=200,150"
+                          " --virtual-time-budget=4000 --user-data-dir=" +
+                          profile.string() + " " + mode + " '" + url + "#" + hash + "' > " +
+                          out.string() + " 2>/dev/null";
+    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+    std::ifstream in(out);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  // The largest difference (in 1/255) between the screenshot's region at (x0, 0) and `expected`'s
+  // columns [x0, x1).
+  double screenshot_difference(const fs::path& shot, const emaki::Image<float>& expected, int x0,
+                               int x1) {
+    const emaki::io::AnyImage s = emaki::io::read_image(shot.string());
+    double worst = 0;
+    for (int y = 0; y < expected.height(); ++y)
+      for (int x = x0; x < x1; ++x)
+        for (int c = 0; c < 3; ++c)
+          worst = std::max(worst, std::abs(double(s.value(x, y, c)) - expected(x, y, c)) * 255);
+    return worst;
+  }
+
+  fs::path base;
+  pid_t pid = -1;
+  std::string url;
+  int runs = 0;
+};
+
+TEST_F(ViewBrowser, DomShowsTheFrameTheLayersAndTheManifest) {
+  serve({(base / "a").string()});
+  const std::string dom = browse("frame=1&layer=layers/base", "--dump-dom");
+  EXPECT_NE(dom.find("id=\"frame-number\">1<"), std::string::npos) << dom;
+  for (const char* layer : {"composite", "layers/base", "layers/shadow"})
+    EXPECT_NE(dom.find(std::string("data-layer=\"") + layer + "\""), std::string::npos) << layer;
+  EXPECT_NE(dom.find("emaki_version = browser-test-0"), std::string::npos);
+  EXPECT_NE(dom.find("(3 frames)"), std::string::npos);
+  EXPECT_NE(dom.find("files/0/layers/base/base_0001.png"), std::string::npos);
+}
+
+TEST_F(ViewBrowser, TheHashStepsToAnotherFrame) {
+  serve({(base / "a").string()});
+  EXPECT_NE(browse("frame=2", "--dump-dom").find("id=\"frame-number\">2<"), std::string::npos);
+  // A frame that does not exist lands on the nearest one.
+  EXPECT_NE(browse("frame=9", "--dump-dom").find("id=\"frame-number\">2<"), std::string::npos);
+}
+
+TEST_F(ViewBrowser, TheScreenshotIsTheFramesPixels) {
+  serve({(base / "a").string()});
+  const fs::path shot = base / "frame2.png";
+  browse("frame=2&layer=composite&bare=1", "--screenshot=" + shot.string());
+  ASSERT_TRUE(fs::exists(shot));
+  EXPECT_LE(screenshot_difference(shot, frame_image(2, 0), 0, 64), 2.0);
+  EXPECT_GT(screenshot_difference(shot, frame_image(1, 0), 0, 64), 20.0);
+}
+
+TEST_F(ViewBrowser, TheWipeShowsAOnTheLeftAndBOnTheRight) {
+  serve({(base / "a").string(), (base / "b").string()});
+  const std::string dom = browse("frame=1&compare=wipe&wipe=0.5", "--dump-dom");
+  EXPECT_NE(dom.find("emaki_version = browser-test-1"), std::string::npos);
+  const fs::path shot = base / "wipe.png";
+  browse("frame=1&compare=wipe&wipe=0.5&bare=1", "--screenshot=" + shot.string());
+  ASSERT_TRUE(fs::exists(shot));
+  EXPECT_LE(screenshot_difference(shot, frame_image(1, 0), 0, 31), 2.0);
+  EXPECT_LE(screenshot_difference(shot, frame_image(1, 1), 33, 64), 2.0);
+}
+
+}  // namespace
