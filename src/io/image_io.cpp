@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/exr_header.h"
+#include "io/exr_plain.h"
 #include "io/oiio_backend.h"
 #include "io/png_io.h"
 #include "io/read_limits.h"
@@ -274,6 +275,9 @@ AnyImage read_open_file(std::FILE* f, const std::string& path, const ReadOptions
       detail::check_exr_complete(f, path);
     else
       detail::check_exr_header(f, path);
+    // The files emaki writes are read without OpenImageIO (io/exr_plain.h).
+    if (std::optional<AnyImage> plain = detail::read_plain_exr(f, path, options.channels))
+      return std::move(*plain);
     rewind_or_throw(f, path);
   }
   AnyImage result;
@@ -440,6 +444,13 @@ void write_image(const std::string& path, ImageView<const float> image,
     tmp.commit([&](const std::string& t) { detail::check_png_complete(t, bytes, path); });
     return;
   }
+  if (ext == ".exr")
+    if (const std::optional<std::string> bytes =
+            detail::encode_plain_exr(image, options, type == 2)) {
+      tmp.write(bytes->data(), bytes->size());
+      tmp.commit([&](const std::string& t) { check_structure(t, ext, path); });
+      return;
+    }
   {
     std::lock_guard lock(detail::oiio_mutex());
     if (std::string e = detail::oiio_backend(path).write(tmp.path(), image, options, type);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <mutex>
 #include <optional>
 
 #include "core/error.h"
@@ -93,6 +94,30 @@ class ColourConvertedFrames : public pipeline::FrameSource {
   std::unique_ptr<pipeline::FrameSource> inner_;
 };
 
+// A scene's frames, the scene loaded when a frame is first rendered.
+class LazySceneFrames final : public pipeline::FrameSource {
+ public:
+  explicit LazySceneFrames(const pipeline::Source& source) : source_(source) {}
+  void load() const {
+    std::call_once(loaded_, [this] {
+      try {
+        frames_ = pipeline::scene_frames(load_scene(source_), source_);
+      } catch (const Error& e) {
+        rethrow_as_key(e, "source");
+      }
+    });
+  }
+  Image<float> passes(int frame) const override {
+    load();
+    return frames_->passes(frame);
+  }
+
+ private:
+  const pipeline::Source source_;
+  mutable std::once_flag loaded_;
+  mutable std::unique_ptr<pipeline::FrameSource> frames_;
+};
+
 }  // namespace
 
 std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
@@ -103,7 +128,15 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
       if (shot.colour.get().is_identity(s.passes_colorspace, "scene_linear")) return frames;
       return std::make_unique<ColourConvertedFrames>(shot, std::move(frames));
     }
-    return io::with_pass_cache(shot, pipeline::scene_frames(load_scene(s), s));
+    auto lazy = std::make_unique<LazySceneFrames>(s);
+    const LazySceneFrames* scene = lazy.get();
+    std::unique_ptr<pipeline::FrameSource> frames = io::with_pass_cache(shot, std::move(lazy));
+    // Without a current pass cache every frame is rendered: the scene is loaded now, so that a
+    // bad one fails before any output is written. With one, its passes were rendered from this
+    // very scene file (the cache's manifest holds its digest), and a farm task that only reads
+    // them (a layer or composite task) never parses the scene nor decodes its textures.
+    if (frames.get() == scene) scene->load();
+    return frames;
   } catch (const Error& e) {
     rethrow_as_key(e, "source");
   }
