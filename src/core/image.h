@@ -78,7 +78,7 @@ class Image {
     const std::size_t bytes = std::max<std::size_t>(padded * height, kRowAlign);
     T* mem = static_cast<T*>(std::aligned_alloc(kRowAlign, bytes));
     if (mem == nullptr) throw std::bad_alloc();
-    mem_.reset(mem);
+    mem_ = std::unique_ptr<T, Free>(mem, Free{});
     if (const detail::ImageBlockHook hook =
             detail::image_block_hook.load(std::memory_order_relaxed))
       hook(mem, bytes);
@@ -87,6 +87,21 @@ class Image {
     channels_ = channels;
     stride_ = std::ptrdiff_t(padded / sizeof(T));
     std::memset(mem_.get(), 0, bytes);
+  }
+
+  // An image over a block the caller made (rows `stride` elements apart, the first at `data`,
+  // aligned to kRowAlign), handed back as release(block, bytes) when the image goes: a file
+  // mapped into memory is so read without a copy into fresh pages (store/reference_cache.cpp).
+  static Image adopt(T* data, int width, int height, int channels, std::ptrdiff_t stride,
+                     void* block, std::size_t bytes, void (*release)(void*, std::size_t)) {
+    CHECK_GE(stride, std::ptrdiff_t(width) * channels);
+    Image out;
+    out.mem_ = std::unique_ptr<T, Free>(data, Free{release, block, bytes});
+    out.width_ = width;
+    out.height_ = height;
+    out.channels_ = channels;
+    out.stride_ = stride;
+    return out;
   }
 
   Image clone() const {
@@ -119,8 +134,17 @@ class Image {
   }
 
  private:
+  // std::free, unless the block was adopted.
   struct Free {
-    void operator()(T* p) const { std::free(p); }
+    void (*release)(void*, std::size_t) = nullptr;
+    void* block = nullptr;
+    std::size_t bytes = 0;
+    void operator()(T* p) const {
+      if (release)
+        release(block, bytes);
+      else
+        std::free(p);
+    }
   };
   std::unique_ptr<T, Free> mem_;
   int width_ = 0, height_ = 0, channels_ = 0;

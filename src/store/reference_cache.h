@@ -1,8 +1,9 @@
 // The reference passes of MatCap-like exemplars (the sphere rendered at the painting's size),
 // kept under a shot's output folder so that its run and each of its farm tasks need not render
-// them again: OUTPUT/references/KEY.exr (float, every pass), KEY a digest of everything the
-// render depends on (store/settings_manifests.h reference_manifest), and beside it KEY.digest,
-// the digest of its pixels, checked when it is read. Both are written through temporaries and
+// them again: OUTPUT/references/KEY.passes (float, every pass, rows as Image<float> holds them:
+// read by mapping the file, without a copy), KEY a digest of everything the render depends on
+// (store/settings_manifests.h reference_manifest), and beside it KEY.digest, the digest of its
+// pixels, checked when it is read. Both are written through temporaries and
 // renamed (io/temp_file.h): a killed write or a full disk leaves no file that is read as a
 // reference; a file that fails its check is rendered again.
 #pragma once
