@@ -63,6 +63,21 @@ TEST_F(ReferenceCache, KeptPassesReadBackExactlyAndOnlyWhenTheyCheck) {
   EXPECT_TRUE(read_reference(out, key, 9, 7).has_value());
   fs::remove(digest);
   EXPECT_FALSE(read_reference(out, key, 9, 7).has_value());
+  // Cut short, or grown: not read (the file is mapped, so its size must be the image's).
+  write_reference(out, key, im.cview());
+  const fs::path pixels = dir_ / "references" / (key + ".passes");
+  const auto size = fs::file_size(pixels);
+  fs::resize_file(pixels, size - 4);
+  EXPECT_FALSE(read_reference(out, key, 9, 7).has_value());
+  fs::resize_file(pixels, size + 64);
+  EXPECT_FALSE(read_reference(out, key, 9, 7).has_value());
+  // The mapped image outlives nothing it needs: moved, it still reads.
+  write_reference(out, key, im.cview());
+  std::optional<Image<float>> kept = read_reference(out, key, 9, 7);
+  ASSERT_TRUE(kept.has_value());
+  Image<float> moved = std::move(*kept);
+  kept.reset();
+  EXPECT_EQ(moved(8, 6, render::kChannelCount - 1), im(8, 6, render::kChannelCount - 1));
 }
 
 }  // namespace
