@@ -21,6 +21,7 @@ namespace {
 
 constexpr const char* kReadDoc =
     R"(read_image(path, channels=None)
+--
 
 Reads an image file: PNG (8/16-bit), EXR (half/float), TIFF, JPEG.
 
@@ -30,8 +31,9 @@ Args:
         searched in every part of a multilayer EXR; None (default): every channel.
 
 Returns:
-    An HxWxC array in the file's precision: uint8, uint16 or float32 (half is read as float),
-    always 3-dimensional (C = 1 for a gray file).
+    An array in the file's precision: uint8, uint16 or float32 (half is read as float);
+    HxW for one channel (a gray file, or one channel asked for), else HxWxC. The same
+    convention as render(), template() and synthesize(), and write_image() takes it back.
 
 Raises:
     emaki.FileError: (also an OSError) a missing, unreadable or corrupt file, one over the
@@ -39,6 +41,7 @@ Raises:
 )";
 
 constexpr const char* kWriteDoc = R"(write_image(path, image, *, channels=None, depth=None)
+--
 
 Writes an image file atomically (a temporary, then a rename).
 
@@ -60,6 +63,7 @@ Raises:
 
 constexpr const char* kConvertDoc =
     R"(convert_colorspace(image, src, dst, config=None)
+--
 
 Converts an image's colours from one OpenColorIO colour space to another, as a shot's inputs
 are converted (docs/shot_file.md, Colour management).
@@ -108,7 +112,11 @@ py::array read_image(const std::filesystem::path& path,
   return std::visit(
       [](const auto& image) -> py::array {
         using T = std::remove_const_t<std::remove_reference_t<decltype(image(0, 0))>>;
-        py::array_t<T> out({image.height(), image.width(), image.channels()});
+        // One channel is HxW, as render() and synthesize() return it (docs/python.md).
+        py::array_t<T> out =
+            image.channels() == 1
+                ? py::array_t<T>({image.height(), image.width()})
+                : py::array_t<T>({image.height(), image.width(), image.channels()});
         T* dst = out.mutable_data();
         const std::size_t row = std::size_t(image.width()) * image.channels();
         for (int y = 0; y < image.height(); ++y, dst += row)
@@ -162,7 +170,8 @@ void bind_images(py::module_& m) {
   m.def("convert_colorspace", &convert_colorspace, kConvertDoc, py::arg("image"), py::arg("src"),
         py::arg("dst"), py::arg("config") = py::none());
   m.def("image_channels", &image_channels,
-        "image_channels(path) -> list[str]\n\nThe channel names of every part of an image file, in "
+        "image_channels(path)\n--\n\nA list[str]: the channel names of every part of an image "
+        "file, in "
         "order (e.g. 'normal.X', ...). "
         "Raises emaki.FileError for a file that cannot be read.",
         py::arg("path"));

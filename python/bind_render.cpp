@@ -28,6 +28,7 @@ using Size = std::array<int, 2>;
 
 constexpr const char* kRenderDoc =
     R"(render(scene, frame=0, size=(640, 360), *, frames=None, clip=None, fps=24.0, start=0.0, loop=False, aa=2, outline_width=1.5, camera=None, target=None, azimuth=30.0, elevation=15.0, distance=0.0, fov=40.0, gltf_camera=None, light=(-1.0, 1.0, 1.0), light_world=False, softness=2.0, ground=True, threads=0, allow_outside_paths=False)
+--
 
 Renders the guide passes of a glTF 2.0 scene at one frame (as `emaki render`).
 
@@ -75,6 +76,7 @@ Raises:
 
 constexpr const char* kTemplateDoc =
     R"(template(size=(1024, 768), *, sphere=None, elevation=10.0, horizon=None, fov=30.0, light=(-1.0, 1.0, 1.0), softness=2.0, ground=True, aa=3, outline_width=1.5, threads=0)
+--
 
 The reference sphere's passes and paint template (as `emaki template`).
 

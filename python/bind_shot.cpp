@@ -43,6 +43,14 @@ class PyShot {
 
   const pipeline::Shot& shot() const { return shot_; }
 
+  std::string repr() const {
+    std::string layers;
+    for (const auto& l : shot_.layers) layers += (layers.empty() ? "" : ", ") + l.name;
+    return fmt::format("<emaki.Shot {} frames {}-{} {}x{} layers [{}]>",
+                       std::string(py::repr(py::str(shot_.path))), shot_.source.first_frame,
+                       shot_.source.last_frame, shot_.source.width, shot_.source.height, layers);
+  }
+
   py::dict run(const py::object& frames, const py::object& layers, bool force, bool previews,
                const py::object& threads, const py::object& progress,
                const py::object& max_memory_mb) {
@@ -247,20 +255,13 @@ def from_dict(d, path="shot.toml"):
 void bind_shot(py::module_& m) {
   py::class_<PyShot>(m, "Shot", kShotDoc)
       .def(py::init(&PyShot::load), py::arg("path"),
-           "Shot(path: str | os.PathLike) -> Shot\n\nThe same as Shot.load(path).")
-      .def_static("load", &PyShot::load, py::arg("path"),
-                  "load(path: str | os.PathLike) -> Shot\n\nReads and checks a shot file; "
-                  "writes nothing.")
-      .def("__repr__",
-           [](const PyShot& s) {
-             const pipeline::Shot& shot = s.shot();
-             std::string layers;
-             for (const auto& l : shot.layers) layers += (layers.empty() ? "" : ", ") + l.name;
-             return fmt::format("<emaki.Shot {} frames {}-{} {}x{} layers [{}]>",
-                                std::string(py::repr(py::str(shot.path))), shot.source.first_frame,
-                                shot.source.last_frame, shot.source.width, shot.source.height,
-                                layers);
-           })
+           "__init__(self, path)\n--\n\nShot(path), path a str or os.PathLike: the same as "
+           "Shot.load(path).")
+      .def_static(
+          "load", &PyShot::load, py::arg("path"),
+          "load(path)\n--\n\nReads and checks a shot file (a str or os.PathLike) and returns "
+          "its Shot; writes nothing.")
+      .def("__repr__", &PyShot::repr)
       .def_static("_from_toml", &PyShot::from_toml, py::arg("text"), py::arg("path"))
       .def_property_readonly("path",
                              [](const PyShot& s) { return std::filesystem::path(s.shot().path); })
@@ -286,8 +287,8 @@ void bind_shot(py::module_& m) {
            py::arg("layers") = py::none(), py::arg("force") = false, py::arg("previews") = true,
            py::arg("threads") = py::none(), py::arg("progress") = py::none(),
            py::arg("max_memory_mb") = py::none(),
-           "run(*, frames=None, layers=None, force=False, previews=True, threads=None, "
-           "progress=None, max_memory_mb=None) -> dict\n\n"
+           "run(self, *, frames=None, layers=None, force=False, previews=True, threads=None, "
+           "progress=None, max_memory_mb=None)\n--\n\n"
            "Synthesizes every layer of the requested frames (with the temporal chain), composites "
            "them and writes the shot's outputs; resumes after the last finished frame.\n"
            "frames: None (all), a frame, or (first, last) inclusive, within the shot's frames.\n"
@@ -300,20 +301,22 @@ void bind_shot(py::module_& m) {
            "The GIL is released while it runs; Ctrl-C stops it after the current layer-frame.\n"
            "Returns {synthesized, reused, composited, frames, previews (a list of "
            "pathlib.Path)}.")
-      .def("composite", &PyShot::composite, py::kw_only(), py::arg("frames") = py::none(),
-           py::arg("previews") = true, py::arg("threads") = py::none(),
-           py::arg("max_memory_mb") = py::none(),
-           "composite(*, frames=None, previews=True, threads=None, max_memory_mb=None) -> int\n\n"
-           "Re-composites finished layers with the shot's colours, blends and paper; returns the "
-           "frames written.")
+      .def(
+          "composite", &PyShot::composite, py::kw_only(), py::arg("frames") = py::none(),
+          py::arg("previews") = true, py::arg("threads") = py::none(),
+          py::arg("max_memory_mb") = py::none(),
+          "composite(self, *, frames=None, previews=True, threads=None, max_memory_mb=None)\n--\n\n"
+          "Re-composites finished layers with the shot's colours, blends and paper; returns the "
+          "frames written.")
       .def("flicker", &PyShot::flicker, py::arg("layer"), py::kw_only(),
            py::arg("frames") = py::none(),
-           "flicker(layer, *, frames=None) -> dict\n\nTemporal error of a finished layer over at "
+           "flicker(self, layer, *, frames=None)\n--\n\nTemporal error of a finished layer over at "
            "least two frames: {layer, frames, mean, objects, ground, per_frame}.")
       .def("plan", &PyShot::plan, py::kw_only(), py::arg("chunk") = 8, py::arg("threads") = 1,
            py::arg("emaki") = "emaki",
-           "plan(*, chunk=8, threads=1, emaki='emaki') -> dict\n\nThe render-farm task graph "
-           "(docs/farm.md): chunk frames per chunked task, [1, 1000000]; threads per task; emaki "
+           "plan(self, *, chunk=8, threads=1, emaki='emaki')\n--\n\nThe render-farm task graph "
+           "as a dict (docs/farm.md): chunk frames per chunked task, [1, 1000000]; threads per "
+           "task; emaki "
            "the binary the tasks run.");
   py::dict scope;
   scope["__builtins__"] = py::module_::import("builtins");

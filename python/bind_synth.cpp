@@ -21,6 +21,7 @@ namespace {
 
 constexpr const char* kDoc =
     R"(synthesize(style, guides, mask=None, *, style_weight=None, uniformity=3500.0, patch_size=5, pyramid_levels=None, search_vote_iters=None, patch_match_iters=None, extra_pass_3x3=False, vote='weighted', seed=1, threads=0, nnf=False, error=False, dtype=None, progress=None)
+--
 
 Guided patch-based synthesis (A : A' :: B : B'), as `emaki synth`.
 

@@ -48,7 +48,8 @@ Viewer view_folders(const fs::path& folder, const std::optional<fs::path>& folde
 }
 
 constexpr const char* kDoc =
-    R"(view(folder, folder_b=None, *, port=0, bind='127.0.0.1') -> Viewer
+    R"(view(folder, folder_b=None, *, port=0, bind='127.0.0.1')
+--
 
 The page of `emaki view` (docs/view.md) over a shot's output folder, and a second one to
 compare: frames, layers, an A/B wipe, the contact sheet and the manifests. The server runs on
@@ -74,9 +75,12 @@ void bind_view(py::module_& m) {
   py::class_<Viewer>(m, "Viewer", "A running emaki view server (emaki.view()).")
       .def_readonly("url", &Viewer::url)
       .def_readonly("port", &Viewer::port)
-      .def("stop", &Viewer::stop, "stop() -> None\n\nStops the server; safe to call twice.")
-      .def("__enter__", [](Viewer& v) -> Viewer& { return v; })
-      .def("__exit__", [](Viewer& v, py::args) { v.stop(); })
+      .def("stop", &Viewer::stop, "stop(self)\n--\n\nStops the server; safe to call twice.")
+      .def(
+          "__enter__", [](Viewer& v) -> Viewer& { return v; }, "__enter__(self)\n--\n\n")
+      .def(
+          "__exit__", [](Viewer& v, py::args) { v.stop(); },
+          "__exit__(self, *args)\n--\n\nStops the server.")
       .def("__repr__", [](const Viewer& v) { return "<emaki.Viewer " + v.url + ">"; });
   m.def("view", &view_folders, kDoc, py::arg("folder"), py::arg("folder_b") = py::none(),
         py::kw_only(), py::arg("port") = 0, py::arg("bind") = "127.0.0.1");

@@ -74,6 +74,7 @@ def synthesize(
     dtype: Optional[DType] = None,
     progress: Optional[Callable[[dict], object]] = None,
 ) -> Union[Array, Tuple[Array, ...]]: ...
+# One channel is HxW, any other count HxWxC, for every function (in and out).
 def read_image(path: PathLike, channels: Optional[Sequence[str]] = None) -> Array: ...
 def write_image(
     path: PathLike,

@@ -18,13 +18,16 @@ PYBIND11_MODULE(emaki, m) {
       "template()  the reference sphere's passes and paint template (as `emaki template`)\n"
       "Shot  a shot file: run(), composite(), flicker(), plan() (as `emaki run`, ...)\n"
       "view()  the page of output folders (as `emaki view`)\n"
-      "Error, InputError, FileError  the exceptions; `subject` names the argument or file";
+      "Error, InputError, FileError  the exceptions; `subject` names the argument or file\n\n"
+      "Images are numpy arrays: HxW for one channel, HxWxC otherwise, in and out.";
   m.attr("__version__") = emaki::version();
   // The one performance switch (core/performance.h), as the command line applies it: huge-page
   // advice on large images, SIMD kernels unless EMAKI_SIMD=scalar.
   emaki::set_performance(emaki::performance_from_environment());
-  // Each docstring starts with its own signature (Python types, as in emaki.pyi) instead of
-  // pybind11's, which would show C++ handle types.
+  // Each docstring starts with its own signature instead of pybind11's (which would show C++
+  // handle types), in CPython's text-signature form, `name(args)\n--\n\n`: `__text_signature__`
+  // then gives inspect.signature() the parameters and defaults, and help() shows them
+  // (python/tests/test_docs.py checks them against emaki.pyi).
   py::options options;
   options.disable_function_signatures();
   bind_errors(m);

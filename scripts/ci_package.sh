@@ -53,8 +53,9 @@ test -f "$P/share/emaki/examples/fox/shot.toml" || fail "no example shot"
 plugin=$(plugin_loaded "$P/bin/emaki" template --size 32x24 --aa 1 --out "$WORK/template")
 [ "$plugin" = "$P/bin/../lib/emaki/libemaki_io_oiio.so" ] || fail "emaki loaded '$plugin'"
 plugin=$(PYTHONPATH=$P/lib/python3/dist-packages plugin_loaded /usr/bin/python3 -c "
-import sys, emaki
+import inspect, sys, emaki
 assert 'emaki ' + emaki.__version__ == sys.argv[1], emaki.__version__
+assert str(inspect.signature(emaki.read_image)) == '(path, channels=None)'
 assert emaki.__file__.startswith(sys.argv[2]), emaki.__file__
 emaki.read_image(sys.argv[3])" "$version" "$P/lib/python3/dist-packages/" "$WORK/template/reference.exr")
 case "$plugin" in

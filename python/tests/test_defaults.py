@@ -4,6 +4,7 @@ template --elevation`, emaki.template(elevation=) and the Blender exporter's --e
 show and use the same value. A painting made over a default template then matches a shot's
 default guides."""
 
+import inspect
 import re
 import subprocess
 
@@ -36,9 +37,7 @@ def exporter_default():
 
 
 def python_documented_default():
-    m = re.search(r"elevation=([-\d.]+)", emaki.template.__doc__.splitlines()[0])
-    assert m, emaki.template.__doc__
-    return float(m.group(1))
+    return inspect.signature(emaki.template).parameters["elevation"].default
 
 
 def test_every_front_end_has_one_reference_elevation():

@@ -1,4 +1,5 @@
-"""emaki.read_image / write_image / image_channels: dtypes kept, EXR channels by name."""
+"""emaki.read_image / write_image / image_channels: dtypes kept, EXR channels by name, one
+array convention (HxW for one channel, HxWxC otherwise) shared with render() and synthesize()."""
 
 import numpy as np
 import pytest
@@ -17,7 +18,7 @@ def test_png_round_trips_in_the_arrays_dtype(tmp_path):
     assert np.array_equal(emaki.read_image(tmp_path / "a.png"), u8)
     assert np.array_equal(emaki.read_image(tmp_path / "b.png"), u16)
     back = emaki.read_image(tmp_path / "c.png")
-    assert back.shape == (20, 30, 1) and np.array_equal(back[:, :, 0], gray)
+    assert back.shape == (20, 30) and np.array_equal(back, gray)
     emaki.write_image(tmp_path / "d.png", u16, depth=8)
     assert emaki.read_image(tmp_path / "d.png").dtype == np.uint8
 
@@ -36,6 +37,8 @@ def test_exr_channels_by_name(tmp_path):
     assert np.array_equal(depth_normal, passes[:, :, [3, 0]])
     emaki.write_image(tmp_path / "h.exr", passes, channels=names, depth="half")
     assert np.allclose(emaki.read_image(tmp_path / "h.exr"), passes[:, :, order], atol=5e-3)
+    depth = emaki.read_image(tmp_path / "p.exr", channels=["depth.Y"])
+    assert depth.shape == (12, 16) and np.array_equal(depth, passes[:, :, 3])
     with pytest.raises(emaki.FileError, match="normal.W"):
         emaki.read_image(tmp_path / "p.exr", channels=["normal.W"])
 
@@ -53,3 +56,17 @@ def test_write_errors_name_the_argument(tmp_path):
     assert e.value.subject == "image"
     with pytest.raises(emaki.FileError):
         emaki.write_image(tmp_path / "x.bmp", a)
+
+
+def test_one_channel_is_hxw_in_every_function(tmp_path):
+    """A one-channel image has one shape whichever function made it, and goes back in as is."""
+    passes = emaki.template((16, 12), aa=1, threads=1)
+    emaki.write_image(tmp_path / "diffuse.exr", passes["diffuse"], channels=["diffuse.Y"])
+    from_file = emaki.read_image(tmp_path / "diffuse.exr")
+    assert passes["diffuse"].shape == from_file.shape == (12, 16)
+    assert np.array_equal(passes["diffuse"], from_file)
+    style = np.random.default_rng(3).random((12, 16), dtype=np.float32)
+    out = emaki.synthesize(style, [(from_file, from_file)], pyramid_levels=1, threads=1)
+    assert out.shape == style.shape
+    emaki.write_image(tmp_path / "out.exr", out)
+    assert emaki.read_image(tmp_path / "out.exr").shape == (12, 16)

@@ -15,8 +15,6 @@ def assert_same_passes(passes, exr):
     assert sorted(emaki.image_channels(exr)) == sorted(sum(emaki.pass_channels.values(), []))
     for name, array in passes.items():
         from_file = emaki.read_image(exr, channels=emaki.pass_channels[name])
-        if array.ndim == 2:
-            array = array[:, :, None]
         assert array.dtype == np.float32 and array.shape == from_file.shape, name
         assert np.array_equal(array, from_file), name
 

@@ -170,3 +170,8 @@ def test_the_gil_is_released_while_a_shot_runs(tmp_path):
         stop.set()
         t.join()
     assert len(ticks) > 20
+
+
+def test_shot_without_a_path_is_a_type_error_naming_it():
+    with pytest.raises(TypeError, match="path"):
+        emaki.Shot()

@@ -52,7 +52,7 @@ as_bytes = np.floor(np.clip(expected, 0, 1) * 255 + 0.5) / 255
 worst = float(np.abs(pixels - as_bytes).max())
 assert worst <= 1.0 / 255 + 1e-6, worst
 coverage = emaki.read_image(frame, channels=["alpha.A"] if "alpha.A" in emaki.image_channels(frame)
-                            else ["alpha.V"])[:, :, 0]
+                            else ["alpha.V"])
 assert np.abs(pixels[:, :, 3] - np.clip(coverage, 0, 1)).max() <= 1.0 / 255 + 1e-6
 covered = coverage > 0.5
 assert covered.mean() > 0.05, covered.mean()

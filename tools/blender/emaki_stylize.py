@@ -69,8 +69,7 @@ def stylize(emaki, painting, painting_passes, frame_passes):
     guides = [(read_pass(emaki, painting_passes, name), read_pass(emaki, frame_passes, name),
                weight) for name, weight in GUIDES]
     coverage = read_pass(emaki, frame_passes, "alpha")
-    return emaki.synthesize(style, guides, np.ascontiguousarray(coverage[:, :, 0]),
-                            dtype=np.float32)
+    return emaki.synthesize(style, guides, coverage, dtype=np.float32)
 
 
 def show_image(context, name, pixels):
