@@ -1,7 +1,8 @@
 // emaki view's page in Debian's headless Chromium: the binary serves small output folders (the
-// layout `emaki run` writes: composite/, layers/NAME/, manifests, contact sheet), Chromium loads
-// the page at a frame and layer named in the URL's hash, and the DOM (frame number, layer names,
-// manifest) and a screenshot (against the frame's own pixels, and an A/B wipe) are checked.
+// layout `emaki run` writes: composite/, layers/NAME/, QA maps under qa/KIND/LAYER/, manifests,
+// contact sheet), Chromium loads the page at a frame and layer named in the URL's hash, and the
+// DOM (frame number, layer and overlay names, manifest) and a screenshot (against the frame's own
+// pixels, a QA map over it, and an A/B wipe) are checked.
 // Skipped when chromium is not installed (scripts/setup.sh installs it).
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -45,6 +46,15 @@ emaki::Image<float> frame_image(int frame, int ab) {
   return img;
 }
 
+// A QA map as `emaki qa flicker --maps` writes it (store/qa_maps.h): a colour over the left half,
+// black (nothing measured) over the right.
+emaki::Image<float> map_image() {
+  emaki::Image<float> img(64, 48, 3);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 32; ++x) img(x, y, 0) = 0.8f, img(x, y, 1) = 0.4f;
+  return img;
+}
+
 void write_output(const fs::path& dir, int ab) {
   fs::create_directories(dir / "composite");
   for (const char* layer : {"base", "shadow"}) fs::create_directories(dir / "layers" / layer);
@@ -56,6 +66,14 @@ void write_output(const fs::path& dir, int ab) {
       std::snprintf(name, sizeof name, "%s_%04d.png", layer, f);
       emaki::io::write_image((dir / "layers" / layer / name).string(),
                              frame_image(f + 5, ab).cview());
+    }
+  }
+  for (const char* kind : {"flicker", "error"}) {
+    fs::create_directories(dir / "qa" / kind / "base");
+    for (int f = 1; f < 3; ++f) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%04d.png", f);
+      emaki::io::write_image((dir / "qa" / kind / "base" / name).string(), map_image().cview());
     }
   }
   emaki::io::write_image((dir / "contact_sheet.png").string(), frame_image(0, ab).cview());
@@ -145,8 +163,12 @@ TEST_F(ViewBrowser, DomShowsTheFrameTheLayersAndTheManifest) {
   serve({(base / "a").string()});
   const std::string dom = browse("frame=1&layer=layers/base", "--dump-dom");
   EXPECT_NE(dom.find("id=\"frame-number\">1<"), std::string::npos) << dom;
-  for (const char* layer : {"composite", "layers/base", "layers/shadow"})
+  for (const char* layer :
+       {"composite", "layers/base", "layers/shadow", "qa/error/base", "qa/flicker/base"}) {
     EXPECT_NE(dom.find(std::string("data-layer=\"") + layer + "\""), std::string::npos) << layer;
+    EXPECT_NE(dom.find(std::string("<option value=\"") + layer + "\""), std::string::npos)
+        << layer << " is not among the overlays";
+  }
   EXPECT_NE(dom.find("emaki_version = browser-test-0"), std::string::npos);
   EXPECT_NE(dom.find("(3 frames)"), std::string::npos);
   EXPECT_NE(dom.find("files/0/layers/base/base_0001.png"), std::string::npos);
@@ -166,6 +188,25 @@ TEST_F(ViewBrowser, TheScreenshotIsTheFramesPixels) {
   ASSERT_TRUE(fs::exists(shot));
   EXPECT_LE(screenshot_difference(shot, frame_image(2, 0), 0, 64), 2.0);
   EXPECT_GT(screenshot_difference(shot, frame_image(1, 0), 0, 64), 20.0);
+}
+
+// A QA map over the frame: screen-blended at 60 % where it has colour, the frame alone where
+// it is black.
+TEST_F(ViewBrowser, AQaMapIsDrawnOverTheFrame) {
+  serve({(base / "a").string()});
+  const fs::path shot = base / "overlay.png";
+  browse("frame=1&layer=composite&overlay=qa/flicker/base&bare=1", "--screenshot=" + shot.string());
+  ASSERT_TRUE(fs::exists(shot));
+  const emaki::Image<float> frame = frame_image(1, 0), map = map_image();
+  emaki::Image<float> blended = frame.clone();
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float a = frame(x, y, c), b = map(x, y, c);
+        blended(x, y, c) = a + 0.6f * b * (1 - a);  // a + 0.6 (screen(a, b) - a)
+      }
+  EXPECT_LE(screenshot_difference(shot, blended, 0, 64), 3.0);
+  EXPECT_GT(screenshot_difference(shot, frame, 0, 32), 20.0);
 }
 
 TEST_F(ViewBrowser, TheWipeShowsAOnTheLeftAndBOnTheRight) {

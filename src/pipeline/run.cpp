@@ -12,6 +12,7 @@
 #include "core/fnv.h"
 #include "core/rng.h"
 #include "core/shot_keys.h"
+#include "pipeline/qa_maps.h"
 #include "pipeline/temporal_guide.h"
 #include "pipeline/tone_anchor.h"
 #include "render/passes.h"
@@ -69,6 +70,7 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
 struct LayerFrame {
   Image<float> value;
   Image<int32_t> nnf;
+  Image<float> error;  // when asked: the synthesis error (synth::Result::error)
 };
 
 // The main transfer's schedule with a warm start, unless the layer sets its own counts (which
@@ -154,7 +156,8 @@ Image<int32_t> anchor_layer(const PreparedLayer& p, int frame, const synth::Para
 // runs). `fields`: the frame's advection fields, shared by its layers.
 LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passes, int frame,
                             const Image<float>* previous, const Image<float>* previous_passes,
-                            ImageView<const int32_t> previous_nnf, AdvectionFields* fields) {
+                            ImageView<const int32_t> previous_nnf, AdvectionFields* fields,
+                            bool error = false) {
   const Layer& l = *p.layer;
   const Image<float> mask = layer_mask(passes, l.mask);
   const int n = p.value_channels;
@@ -163,7 +166,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     for (int y = 0; y < mask.height() && !any; ++y)
       for (int x = 0; x < mask.width() && !any; ++x) any = mask(x, y) > 0.5f;
     if (!any)  // nothing to synthesize: transparent, and no field
-      return {Image<float>(passes.width, passes.height, n + 1), {}};
+      return {Image<float>(passes.width, passes.height, n + 1), {}, {}};
   }
   std::vector<Image<float>> targets, pass_maps;
   targets.reserve(l.guides.size());  // views point into them: no reallocation
@@ -212,8 +215,9 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   }
   synth::OutputRequest request;
   request.nnf = l.temporal.enabled && l.temporal.warm_start;
+  request.error = error;  // measured once the result is made: it does not change it
   synth::Result r = synth::synthesize(inputs, params, request);
-  return {std::move(r.image), std::move(r.nnf)};
+  return {std::move(r.image), std::move(r.nnf), std::move(r.error)};
 }
 
 std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<std::string>& names) {
@@ -398,7 +402,12 @@ class ShotRun {
           previous && held_[i].frame == f - 1 ? held_[i].nnf.cview() : ImageView<const int32_t>{};
       tick(f, l.name);
       LayerFrame r = synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes,
-                                      previous_nnf, &fields);
+                                      previous_nnf, &fields, o_.error_maps);
+      if (!r.error.empty())
+        store_.write_qa_map("error", l, f,
+                            synthesis_error_map(r.error.cview(), r.value.cview(),
+                                                prepared_[i].value_channels, l.synth.patch_size)
+                                .cview());
       now[i].value = std::move(r.value);
       now[i].nnf = std::move(r.nnf);
       if (!now[i].nnf.empty())

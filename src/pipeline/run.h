@@ -49,6 +49,12 @@ class Store {
   }
   // Removes the layer's field at `frame`, if there is one (TemporalSpec::keep_every_field false).
   virtual void remove_field(const Layer& layer, int frame) { (void)layer, (void)frame; }
+  // A QA map of the layer at `frame` (pipeline/qa_maps.h), `kind` naming it: "error" (the
+  // synthesis error, RunOptions::error_maps), "flicker", "ghost". The default keeps nothing.
+  virtual void write_qa_map(const std::string& kind, const Layer& layer, int frame,
+                            ImageView<const float> map) {
+    (void)kind, (void)layer, (void)frame, (void)map;
+  }
   // True when every per-frame output (composite, layered EXR, ...) of `frame` exists.
   virtual bool has_frame(int frame) const = 0;
   // `composite` is RGBA; `layers` are in shot.layers order.
@@ -70,6 +76,7 @@ struct RunOptions {
   std::vector<std::string> layers;        // empty: all
   bool force = false;                     // synthesize again even when finished
   bool composite = true;                  // false: layers only (a farm's layer task)
+  bool error_maps = false;  // each synthesized layer frame's error map, to Store::write_qa_map
   std::function<void(const Progress&)> progress;
 };
 

@@ -15,6 +15,7 @@
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "store/field_file.h"
+#include "store/qa_maps.h"
 #include "store/settings_manifests.h"
 
 namespace emaki::io {
@@ -296,6 +297,12 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
   exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
   exr.channel_names = value_names("", value.channels, n);
   write_image(paths_.layer_exr(layer.name, frame), value, exr);
+}
+
+void FileStore::write_qa_map(const std::string& kind, const pipeline::Layer& layer, int frame,
+                             ImageView<const float> map) {
+  CHECK(access_ != StoreAccess::kInspect);
+  io::write_qa_map(paths_.folder, kind, layer.name, frame, map);
 }
 
 void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
