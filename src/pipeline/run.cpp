@@ -30,8 +30,9 @@ using Clock = std::chrono::steady_clock;
 struct PreparedLayer {
   const Layer* layer = nullptr;
   int value_channels = 1;
-  Image<float> style;                             // A': the touch (1 channel) or the painting's RGB
-  std::vector<Image<float>> source_guides;        // one per layer->guides entry
+  Image<float> style;  // A': the touch (1 channel) or the painting's RGB
+  // One per layer->guides entry: ExemplarImages::guides' or cut here.
+  std::vector<std::shared_ptr<const Image<float>>> source_guides;
   std::vector<const Image<float>*> painted_maps;  // per guide: its painted weight map, or null
   Image<float> temporal_style;  // A' low-passed for the temporal guide (guide_sigma), or empty
   AnchorExemplar anchor;        // the tone anchor's exemplar side (TemporalSpec::anchor), or empty
@@ -50,7 +51,11 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     p.style = extract(ex.painting.cview(), 0, 3);
   }
   for (const GuideSpec& g : layer.guides) {
-    p.source_guides.push_back(extract_pass(ex.passes.cview(), g.pass));
+    const auto cut = ex.guides.find(g.pass);
+    p.source_guides.push_back(
+        cut != ex.guides.end()
+            ? cut->second
+            : std::make_shared<const Image<float>>(extract_pass(ex.passes.cview(), g.pass)));
     const auto it = g.map_image.empty() ? maps.end() : maps.find(g.map_image);
     CHECK(g.map_image.empty() || it != maps.end());  // shot::load_weight_maps read every one
     p.painted_maps.push_back(it == maps.end() ? nullptr : &it->second);
@@ -59,7 +64,7 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     p.temporal_style = temporal::low_pass(p.style.cview(), layer.temporal.guide_sigma);
   if (layer.temporal.enabled && layer.temporal.anchor > 0) {
     std::vector<synth::Plane> sources;
-    for (const Image<float>& g : p.source_guides) sources.push_back(g.cview());
+    for (const auto& g : p.source_guides) sources.push_back(g->cview());
     p.anchor = anchor_exemplar(p.style.cview(), sources, layer.temporal.anchor);
   }
   return p;
@@ -177,7 +182,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   for (std::size_t i = 0; i < l.guides.size(); ++i) {
     const GuideSpec& g = l.guides[i];
     targets.push_back(extract_pass(passes, g.pass));
-    synth::GuidePair pair{shot_keys::layer_guide(l.name, g.pass), p.source_guides[i].cview(),
+    synth::GuidePair pair{shot_keys::layer_guide(l.name, g.pass), p.source_guides[i]->cview(),
                           targets.back().cview(), g.weight};
     if (!g.map_pass.empty()) {
       pass_maps.push_back(extract_pass(passes, g.map_pass));

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,10 @@ namespace emaki::pipeline {
 // it was painted over (kChannelCount channels, the painting's size).
 struct ExemplarImages {
   Image<float> painting;
-  Image<float> passes;
+  Image<float> passes;  // may be empty when `guides` holds every pass its layers use
+  // Passes cut out of `passes` already (extract_pass), by pass name, which the layers take
+  // instead of cutting them again (shot/input_cache.h keeps them between runs).
+  std::map<std::string, std::shared_ptr<const Image<float>>> guides;
 };
 
 // Where layer results and frame outputs live. A layer frame is finished once has_layer says so:

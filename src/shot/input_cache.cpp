@@ -36,16 +36,18 @@ Image<float> KeptFrames::passes(int frame) const {
 InputCache::InputCache() = default;
 InputCache::~InputCache() = default;
 
-const Image<float>* InputCache::find(const std::string& key) {
+std::shared_ptr<const Image<float>> InputCache::find(const std::string& key) {
   const auto it = m_images.find(key);
   if (it == m_images.end()) return nullptr;
   m_used.insert(key);
-  return &it->second;
+  return it->second;
 }
 
-const Image<float>& InputCache::keep(const std::string& key, Image<float> image) {
+std::shared_ptr<const Image<float>> InputCache::keep(const std::string& key, Image<float> image) {
   m_used.insert(key);
-  return m_images.insert_or_assign(key, std::move(image)).first->second;
+  auto kept = std::make_shared<const Image<float>>(std::move(image));
+  m_images.insert_or_assign(key, kept);
+  return kept;
 }
 
 std::unique_ptr<pipeline::FrameSource> InputCache::frames(

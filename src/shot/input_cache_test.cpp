@@ -10,7 +10,10 @@
 #include <iterator>
 #include <string>
 
+#include "io/image_io.h"
+#include "render/passes.h"
 #include "shot/api.h"
+#include "shot/inputs.h"
 #include "tests/small_painting.h"
 #include "tests/test_dir.h"
 
@@ -89,6 +92,41 @@ TEST_F(InputCacheRun, ARunWithTheCacheEqualsOneWithout) {
   run(shot("kept"), frame(1), cache);  // everything from the cache this time
   run(shot("fresh"), frame(1, false));
   expect_same_frame("kept", "fresh");
+}
+
+// A painted key frame over a pass file: the guides cut from the file are kept under its digest,
+// so a pass file saved again (another frame's passes) is read again.
+TEST_F(InputCacheRun, ARunAfterASaveOfThePassFileEqualsAFreshRun) {
+  const std::string passes = (dir_ / "key.exr").string();
+  const auto write_passes = [&](int frame) {
+    const Image<float> p = open_frames(shot("scene"))->passes(frame);
+    io::WriteOptions exr;
+    exr.format = io::SampleFormat::kFloat;
+    exr.channel_names = render::channel_names();
+    io::write_image(passes, p.cview(), exr);
+  };
+  test::write_small_painting(kData + "/stylit/source_style.png", painting(), 40, 24);
+  const auto keyframe = [&](const std::string& out) {
+    const std::string text =
+        "[source]\nscene = \"" + kData + "/scenes/Fox.glb\"\nclip = \"Walk\"\n" +
+        "frames = [0, 1]\nsize = [40, 24]\naa = 1\n[exemplars.key]\nkind = \"keyframe\"\n" +
+        "painting = \"" + painting() + "\"\npasses = \"" + passes + "\"\n[layers.base]\n" +
+        "kind = \"base\"\nexemplar = \"key\"\ntemporal = false\n[outputs]\nfolder = \"" +
+        (dir_ / out).string() + "\"\nmp4 = false\n";
+    return open_text(text, (dir_ / "key.toml").string());
+  };
+  write_passes(0);
+  InputCache cache;
+  run(keyframe("kept"), frame(1), cache);
+  write_passes(1);
+  run(keyframe("kept"), frame(1), cache);
+  run(keyframe("fresh"), frame(1, false));
+  for (const char* f : {"layers/base/base_0001.exr", "composite/frame_0001.png"}) {
+    SCOPED_TRACE(f);
+    const std::string x = bytes_of(dir_ / "kept" / f), y = bytes_of(dir_ / "fresh" / f);
+    ASSERT_FALSE(x.empty());
+    EXPECT_TRUE(x == y);
+  }
 }
 
 }  // namespace

@@ -60,7 +60,7 @@ Image<float> decoded(InputCache* cache, const std::string& kind, const std::stri
                      const std::function<Image<float>(const std::optional<std::string>&)>& decode) {
   if (!cache) return decode(input_bytes(path));
   const std::string prefix = kind + "|" + path + "|";
-  if (const Image<float>* kept = cache->find(prefix + io::file_digest(path))) return kept->clone();
+  if (const auto kept = cache->find(prefix + io::file_digest(path))) return kept->clone();
   // The key is the digest of the very bytes decoded: a file saved again meanwhile misses next
   // time instead of finding this image under its new digest.
   const std::optional<std::string> bytes = input_bytes(path);
@@ -138,17 +138,13 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot, InputCache*
 
 namespace {
 
-// A MatCap-like exemplar's reference passes at w x h: from `cache`, else from the shot's output
-// folder when a task or run kept them there (with `rendered`), else rendered (and then noted in
-// `rendered`).
+// A MatCap-like exemplar's reference passes at w x h: from the shot's output folder when a task
+// or run kept them there (with `rendered`), else rendered (and then noted in `rendered`).
 Image<float> reference_passes(const Shot& shot, const pipeline::Exemplar& e, int w, int h,
-                              std::vector<std::string>* rendered, InputCache* cache) {
-  const std::string key = io::reference_key(e, w, h);
-  if (cache)
-    if (const Image<float>* kept = cache->find("reference|" + key)) return kept->clone();
+                              std::vector<std::string>* rendered) {
   // Rendered once per shot: later tasks and runs read what the first one kept.
   std::optional<Image<float>> kept;
-  if (rendered) kept = io::read_reference(shot.outputs.folder, key, w, h);
+  if (rendered) kept = io::read_reference(shot.outputs.folder, io::reference_key(e, w, h), w, h);
   if (!kept) {
     try {
       kept = pipeline::matcap_passes(e, w, h);
@@ -157,7 +153,6 @@ Image<float> reference_passes(const Shot& shot, const pipeline::Exemplar& e, int
     }
     if (rendered) rendered->push_back(e.name);
   }
-  if (cache) cache->keep("reference|" + key, kept->clone());
   return std::move(*kept);
 }
 
@@ -212,6 +207,38 @@ Image<float> studio_passes(const Shot& shot, const pipeline::Exemplar& e, int w,
   return passes;
 }
 
+// The passes the layers of exemplar `e` use as guides.
+std::vector<std::string> guide_passes(const Shot& shot, const pipeline::Exemplar& e) {
+  std::vector<std::string> out;
+  for (const pipeline::Layer& l : shot.layers)
+    if (l.exemplar == e.name)
+      for (const pipeline::GuideSpec& g : l.guides)
+        if (std::find(out.begin(), out.end(), g.pass) == out.end()) out.push_back(g.pass);
+  return out;
+}
+
+// Fills im.guides from `cache` when it holds every guide of `e`'s layers cut from the passes
+// `from` names; the passes themselves are then not needed.
+bool kept_guides(const Shot& shot, const pipeline::Exemplar& e, InputCache& cache,
+                 const std::string& from, pipeline::ExemplarImages& im) {
+  std::map<std::string, std::shared_ptr<const Image<float>>> guides;
+  for (const std::string& pass : guide_passes(shot, e)) {
+    auto kept = cache.find("guide|" + from + "|" + pass);
+    if (!kept) return false;
+    guides.emplace(pass, std::move(kept));
+  }
+  im.guides = std::move(guides);
+  return true;
+}
+
+// Cuts the guides of `e`'s layers out of im.passes into im.guides, and keeps them in `cache`.
+void keep_guides(const Shot& shot, const pipeline::Exemplar& e, InputCache& cache,
+                 const std::string& from, pipeline::ExemplarImages& im) {
+  for (const std::string& pass : guide_passes(shot, e))
+    im.guides[pass] =
+        cache.keep("guide|" + from + "|" + pass, pipeline::extract_pass(im.passes.cview(), pass));
+}
+
 }  // namespace
 
 std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
@@ -224,17 +251,24 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
     im.painting = rgb_of(key + ".painting", e.painting, cache);
     shot.colour.get().convert(im.painting.view(), e.colorspace, "color_picking");
     const int w = im.painting.width(), h = im.painting.height();
-    if (e.kind == pipeline::ExemplarKind::kMatcap) {
-      im.passes = reference_passes(shot, e, w, h, rendered, cache);
-    } else {
-      // The passes the layers use as guides, read in one go; the rest stay zero.
-      std::string guides = fmt::format("passes {}x{}", w, h);
-      for (const pipeline::Layer& l : shot.layers)
-        if (l.exemplar == e.name)
-          for (const pipeline::GuideSpec& g : l.guides) guides += " " + g.pass;
-      im.passes = decoded(cache, guides, e.passes, [&](const std::optional<std::string>& bytes) {
-        return studio_passes(shot, e, w, h, bytes);
-      });
+    const bool matcap = e.kind == pipeline::ExemplarKind::kMatcap;
+    // With a cache, the guides its layers cut out of the passes, under what the passes are.
+    const auto from = [&](const std::string& digest) {
+      return matcap ? "reference " + io::reference_key(e, w, h)
+                    : fmt::format("passes {}x{} {} {}", w, h, e.passes, digest);
+    };
+    if (!(cache &&
+          kept_guides(shot, e, *cache, from(matcap ? "" : io::file_digest(e.passes)), im))) {
+      std::optional<std::string> bytes;  // a pass file's, read once for its digest and decoding
+      if (matcap) {
+        im.passes = reference_passes(shot, e, w, h, rendered);
+      } else {
+        bytes = input_bytes(e.passes);
+        im.passes = studio_passes(shot, e, w, h, bytes);
+      }
+      // The key names the very bytes decoded: a file saved again meanwhile misses next time.
+      if (cache && (matcap || bytes))
+        keep_guides(shot, e, *cache, from(bytes ? io::bytes_digest(*bytes) : ""), im);
     }
     out.emplace(e.name, std::move(im));
   }
