@@ -19,6 +19,7 @@
 
 #include "core/image.h"
 #include "io/image_io.h"
+#include "tests/small_painting.h"
 
 namespace {
 
@@ -91,13 +92,19 @@ class ViewBrowser : public ::testing::Test {
     write_output(base / "b", 1);
   }
   void TearDown() override {
-    if (pid > 0) {
-      ::kill(pid, SIGTERM);
-      int status = 0;
-      ::waitpid(pid, &status, 0);
-      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "emaki view did not stop";
-    }
+    stop();
     fs::remove_all(base);
+  }
+
+  // Stops the server serve() started.
+  void stop() {
+    if (pid <= 0) return;
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "emaki view did not stop";
+    pid = -1;
+    url.clear();
   }
 
   // Starts `emaki view` on the folders and reads the URL it prints.
@@ -122,17 +129,18 @@ class ViewBrowser : public ::testing::Test {
   }
 
   // Chromium's output for the page at `hash`: the DOM (--dump-dom) or a screenshot file.
-  std::string browse(const std::string& hash, const std::string& mode) {
+  std::string browse(const std::string& hash, const std::string& mode,
+                     const std::string& window = "200,150") {
     const fs::path profile = base / ("profile_" + std::to_string(++runs));
     const fs::path out = base / ("out_" + std::to_string(runs));
     // --no-sandbox: CI runs as root, where Chromium's sandbox refuses to start. The page polls
     // its listing once at load; 4 s of virtual time lets it fetch and draw.
     std::string command = std::string("timeout 120 ") + chromium() +
                           " --headless --no-sandbox --disable-gpu --hide-scrollbars"
-                          " --force-device-scale-factor=1 --window-size=200,150"
-                          " --virtual-time-budget=4000 --user-data-dir=" +
-                          profile.string() + " " + mode + " '" + url + "#" + hash + "' > " +
-                          out.string() + " 2>/dev/null";
+                          " --force-device-scale-factor=1 --window-size=" +
+                          window +
+                          " --virtual-time-budget=4000 --user-data-dir=" + profile.string() + " " +
+                          mode + " '" + url + "#" + hash + "' > " + out.string() + " 2>/dev/null";
     EXPECT_EQ(std::system(command.c_str()), 0) << command;
     std::ifstream in(out);
     std::stringstream s;
@@ -218,6 +226,73 @@ TEST_F(ViewBrowser, TheWipeShowsAOnTheLeftAndBOnTheRight) {
   ASSERT_TRUE(fs::exists(shot));
   EXPECT_LE(screenshot_difference(shot, frame_image(1, 0), 0, 31), 2.0);
   EXPECT_LE(screenshot_difference(shot, frame_image(1, 1), 33, 64), 2.0);
+}
+
+// The guide's screenshots (docs/view.md), made from a real shot: the Fox at 384x216 run with
+// the temporal chain (A, with its error and flicker maps) and frame by frame (B). They are
+// written into the folder EMAKI_SCREENSHOTS names (docs/images to refresh the guide's), else
+// into the test's scratch folder; each must be the page's size and show what it is about.
+TEST_F(ViewBrowser, GuideScreenshots) {
+  const std::string data = EMAKI_TEST_DATA;
+  emaki::test::write_small_painting(data + "/stylit/source_style.png",
+                                    (base / "pastel.png").string(), 300, 228);
+  const auto shot = [&](const std::string& name, bool temporal) {
+    std::ofstream(base / (name + ".toml"))
+        << "[source]\nscene = \"" << data << "/scenes/Fox.glb\"\nclip = \"Walk\"\n"
+        << "frames = [0, 2]\nsize = [384, 216]\naa = 1\n"
+        << "[source.camera]\nazimuth = 35\nelevation = 14\n"
+        << "[source.light]\ndirection = [0.3, 0.9, -0.3]\nsoftness = 8\n"
+        << "[exemplars.pastel]\npainting = \"pastel.png\"\nsphere = [152.05, 123.55, 60.6]\n"
+        << "elevation = 20\nfov = 30\nlight = [0.3, 0.9, -0.3]\nsoftness = 8\n"
+        << "[layers.base]\nkind = \"base\"\nexemplar = \"pastel\"\n"
+        << "guides = { normal = 1.0, diffuse = 1.5 }\n"
+        << (temporal ? "" : "temporal = false\n")
+        << "[layers.shadow]\nkind = \"shadow\"\nexemplar = \"pastel\"\n"
+        << "color = [0.42, 0.40, 0.62]\nblend = \"multiply\"\nopacity = 0.8\n"
+        << (temporal ? "" : "temporal = false\n")
+        << "[layers.outline]\nkind = \"outline\"\nexemplar = \"pastel\"\n"
+        << "color = [0.16, 0.09, 0.07]\n"
+        << (temporal ? "" : "temporal = false\n") << "[compositing]\npaper = \"" << data
+        << "/papers/roughpaper.png\"\n"
+        << "paper_color = [1.0, 0.97, 0.9]\n[outputs]\nfolder = \"" << name << "\"\nmp4 = false\n";
+  };
+  shot("temporal", true);
+  shot("frame_by_frame", false);
+  const auto emaki = [&](const std::string& args) {
+    const std::string command =
+        "cd '" + base.string() + "' && " + EMAKI_BINARY + " " + args + " > /dev/null 2> emaki.log";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  };
+  emaki("run temporal.toml --error-maps");
+  emaki("qa flicker temporal.toml --layer base --maps");
+  emaki("run frame_by_frame.toml");
+  const char* env = std::getenv("EMAKI_SCREENSHOTS");
+  const fs::path out = env && *env ? fs::path(env) : base;
+  const auto screenshot = [&](const std::string& name, const std::string& hash) {
+    const fs::path file = out / name;
+    browse(hash, "--screenshot=" + file.string(), "760,362");
+    const emaki::io::AnyImage s = emaki::io::read_image(file.string());
+    EXPECT_EQ(s.width(), 760) << name;
+    EXPECT_EQ(s.height(), 362) << name;
+    return file;
+  };
+  serve({(base / "temporal").string()});
+  const std::string dom = browse("frame=2&overlay=qa/error/base", "--dump-dom");
+  for (const char* layer : {"layers/outline", "qa/error/base", "qa/flicker/base"})
+    EXPECT_NE(dom.find(std::string("data-layer=\"") + layer + "\""), std::string::npos) << layer;
+  const fs::path player = screenshot("view_player.png", "frame=2");
+  const fs::path overlay = screenshot("view_error_overlay.png", "frame=2&overlay=qa/error/base");
+  // The map over the frame changes it (the frame's top-left corner is at (10, 70) or below).
+  const emaki::io::AnyImage a = emaki::io::read_image(player.string());
+  const emaki::io::AnyImage b = emaki::io::read_image(overlay.string());
+  double moved = 0;
+  for (int y = 70; y < a.height(); ++y)
+    for (int x = 10; x < 394; ++x)
+      moved = std::max(moved, double(std::abs(a.value(x, y, 0) - b.value(x, y, 0))));
+  EXPECT_GT(moved * 255, 20.0);
+  stop();
+  serve({(base / "temporal").string(), (base / "frame_by_frame").string()});
+  screenshot("view_wipe.png", "frame=2&compare=wipe&wipe=0.5");
 }
 
 }  // namespace
