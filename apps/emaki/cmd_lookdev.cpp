@@ -1,7 +1,8 @@
 // `emaki lookdev SHOT --frames 0,24,47 [--scale 0.5]`: a few frames of a shot at preview size,
 // made again whenever the painting(s), the shot file or the passes are saved, on emaki view's
 // page (src/view/). Frames run frame by frame (no temporal chain) into their own folder; a save
-// during a run stops it at the next layer-frame and the run starts over once the saves settle.
+// during a run stops it (within the synthesis in progress: the engine's cancel hook) and the run
+// starts over once the saves settle.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +20,7 @@
 #include "core/utf8.h"
 #include "shot/api.h"
 #include "shot/plan.h"
+#include "synth/synthesizer.h"
 #include "view/rerun.h"
 #include "view/server.h"
 
@@ -125,6 +127,7 @@ bool run_frames(const LookdevOptions& o, const std::vector<int>& frames,
     r.force = true;
     r.previews = false;
     r.error_maps = true;  // the page's overlay: where the painting has no good match
+    r.cancel = [&] { return stale.load(); };  // a save stops the synthesis in progress too
     r.progress = [&](const pipeline::Progress& p) {
       if (stale) throw StaleRun{};
       status.set(fmt::format("frame {} {}", p.frame, p.layer.empty() ? "compositing" : p.layer));
@@ -172,6 +175,8 @@ int run_lookdev(const Args& args) {
     try {
       run_frames(o, frames, stale, status, cache);
     } catch (const StaleRun&) {
+      status.set("a newer save: starting over");
+    } catch (const synth::Cancelled&) {
       status.set("a newer save: starting over");
     } catch (const std::exception& e) {
       status.set(std::string("error: ") + e.what());

@@ -158,11 +158,12 @@ Image<int32_t> anchor_layer(const PreparedLayer& p, int frame, const synth::Para
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
 // temporal chain continues; `previous_nnf`: the field of t-1 (empty: none, the whole pyramid
-// runs). `fields`: the frame's advection fields, shared by its layers.
+// runs). `fields`: the frame's advection fields, shared by its layers. `o`: the run's error
+// maps and cancel hook, if any.
 LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passes, int frame,
                             const Image<float>* previous, const Image<float>* previous_passes,
                             ImageView<const int32_t> previous_nnf, AdvectionFields* fields,
-                            bool error = false) {
+                            const RunOptions* o = nullptr) {
   const Layer& l = *p.layer;
   const Image<float> mask = layer_mask(passes, l.mask);
   const int n = p.value_channels;
@@ -200,6 +201,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
                        inputs);
   if (!mask.empty()) inputs.target_mask = mask.cview();
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
+  if (o) params.cancel = o->cancel;
   const Image<int32_t> anchor_nnf =
       advected.value.empty() ? Image<int32_t>{}
                              : anchor_layer(p, frame, params, mask, temporal_pair, inputs);
@@ -220,7 +222,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   }
   synth::OutputRequest request;
   request.nnf = l.temporal.enabled && l.temporal.warm_start;
-  request.error = error;  // measured once the result is made: it does not change it
+  request.error = o && o->error_maps;  // measured once the result is made: it does not change it
   synth::Result r = synth::synthesize(inputs, params, request);
   return {std::move(r.image), std::move(r.nnf), std::move(r.error)};
 }
@@ -407,7 +409,7 @@ class ShotRun {
           previous && held_[i].frame == f - 1 ? held_[i].nnf.cview() : ImageView<const int32_t>{};
       tick(f, l.name);
       LayerFrame r = synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes,
-                                      previous_nnf, &fields, o_.error_maps);
+                                      previous_nnf, &fields, &o_);
       if (!r.error.empty())
         store_.write_qa_map("error", l, f,
                             synthesis_error_map(r.error.cview(), r.value.cview(),

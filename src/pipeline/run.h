@@ -82,6 +82,9 @@ struct RunOptions {
   bool composite = true;                  // false: layers only (a farm's layer task)
   bool error_maps = false;  // each synthesized layer frame's error map, to Store::write_qa_map
   std::function<void(const Progress&)> progress;
+  // Polled during each synthesis (synth::Params::cancel): true stops the run with
+  // synth::Cancelled, leaving the layer frames written before it; false changes nothing.
+  std::function<bool()> cancel;
 };
 
 struct RunReport {
