@@ -185,6 +185,17 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
   if (const fs::path refs = root / "references"; fs::is_directory(refs, ec))
     clean_up(refs,
              [](const std::string& t) { return t.ends_with(".exr") || t.ends_with(".digest"); });
+  // QA maps (store/qa_maps.h): qa/KIND/LAYER/frame_NNNN.png, in folders (never links) only.
+  const auto folders = [](const fs::path& dir) {
+    std::vector<fs::path> out;
+    std::error_code e;
+    for (fs::directory_iterator it(dir, e), end; !e && it != end; it.increment(e))
+      if (!it->is_symlink(e) && it->is_directory(e)) out.push_back(it->path());
+    return out;
+  };
+  for (const fs::path& kind : folders(root / "qa"))
+    for (const fs::path& layer : folders(kind))
+      clean_up(layer, [](const std::string& t) { return is_frame_name(t, "frame_", {".png"}); });
 }
 
 void FileStore::make_current(Manifested& m, const std::string& folder,
