@@ -1,7 +1,8 @@
 // `emaki lookdev SHOT --frames 0,24,47 [--scale 0.5]`: a few frames of a shot at preview size,
 // made again whenever the painting(s), the shot file or the passes are saved, on emaki view's
 // page (src/view/). Frames run frame by frame (no temporal chain) into their own folder; a save
-// during a run stops it at the next layer-frame and the run starts over once the saves settle.
+// during a run stops it (within the synthesis in progress: the engine's cancel hook) and the run
+// starts over once the saves settle.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +20,7 @@
 #include "core/utf8.h"
 #include "shot/api.h"
 #include "shot/plan.h"
+#include "synth/synthesizer.h"
 #include "view/rerun.h"
 #include "view/server.h"
 
@@ -112,9 +114,10 @@ struct Status {
   }
 };
 
-// One run over the frames; returns whether it finished (not stale).
+// One run over the frames; returns whether it finished (not stale). `cache` keeps the inputs a
+// save did not change from one run to the next.
 bool run_frames(const LookdevOptions& o, const std::vector<int>& frames,
-                const std::atomic<bool>& stale, Status& status) {
+                const std::atomic<bool>& stale, Status& status, shot::InputCache& cache) {
   const auto t0 = std::chrono::steady_clock::now();
   const pipeline::Shot s = preview_shot(o.shot, o.scale, o.out);
   for (const int f : frames) {
@@ -123,11 +126,13 @@ bool run_frames(const LookdevOptions& o, const std::vector<int>& frames,
     r.first_frame = r.last_frame = f;
     r.force = true;
     r.previews = false;
+    r.error_maps = true;  // the page's overlay: where the painting has no good match
+    r.cancel = [&] { return stale.load(); };  // a save stops the synthesis in progress too
     r.progress = [&](const pipeline::Progress& p) {
       if (stale) throw StaleRun{};
       status.set(fmt::format("frame {} {}", p.frame, p.layer.empty() ? "compositing" : p.layer));
     };
-    shot::run(s, r);
+    shot::run(s, r, cache);
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -165,10 +170,13 @@ int run_lookdev(const Args& args) {
   fs::create_directories(o.out);
   Status status;
   view::Server server({o.out}, server_options, [&] { return status.json(); });
+  shot::InputCache cache;  // used by the rerun's thread alone
   view::Rerun rerun(watched_files(shot), [&](const std::atomic<bool>& stale) {
     try {
-      run_frames(o, frames, stale, status);
+      run_frames(o, frames, stale, status, cache);
     } catch (const StaleRun&) {
+      status.set("a newer save: starting over");
+    } catch (const synth::Cancelled&) {
       status.set("a newer save: starting over");
     } catch (const std::exception& e) {
       status.set(std::string("error: ") + e.what());
