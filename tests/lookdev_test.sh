@@ -57,5 +57,25 @@ kill $pid && wait $pid || { echo "FAIL: the fresh lookdev did not stop cleanly";
 for f in composite/frame_0000.png layers/base/base_0000.exr layers/outline/outline_0000.exr; do
   cmp -s "$work/out.lookdev/$f" "$work/fresh/$f" || { echo "FAIL: $f differs from a fresh run"; exit 1; }
 done
+# --temporal: frame 3 from frame 2 made as a chain's first frame, nothing before it; frame 2
+# is frame by frame's, frame 3 is not.
+one_run() {  # OUT_DIR, then lookdev's own options
+  out=$1; shift
+  port=$((port + 1))
+  "$emaki" lookdev "$work/shot.toml" --scale 1 --port "$port" --out "$out" "$@" \
+    > "$work/url" 2> "$work/log" &
+  pid=$!
+  wait_for '"generation":1,'
+  kill $pid && wait $pid || { echo "FAIL: lookdev $* did not stop cleanly"; exit 1; }
+}
+one_run "$work/temporal" --frames 3 --temporal
+one_run "$work/by_frame" --frames 2,3
+[ ! -e "$work/temporal/layers/base/base_0001.exr" ] || { echo "FAIL: --temporal made frame 1"; exit 1; }
+for l in base shadow outline; do
+  cmp -s "$work/temporal/layers/$l/${l}_0002.exr" "$work/by_frame/layers/$l/${l}_0002.exr" ||
+    { echo "FAIL: --temporal's frame 2 ($l) is not frame by frame's"; exit 1; }
+done
+! cmp -s "$work/temporal/layers/base/base_0003.exr" "$work/by_frame/layers/base/base_0003.exr" ||
+  { echo "FAIL: --temporal's frame 3 did not use the chain"; exit 1; }
 trap - EXIT
 echo "ok"

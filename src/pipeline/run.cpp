@@ -306,7 +306,8 @@ class ShotRun {
     selected_ = selected_layers(shot, o.layers);
     for (const Layer* l : selected_)
       prepared_.push_back(prepare(*l, exemplars.at(l->exemplar), maps));
-    first_ = shot.source.first_frame;
+    first_ = o.chain_from < 0 ? shot.source.first_frame
+                              : std::clamp(o.chain_from, shot.source.first_frame, a_);
   }
 
   RunReport run() {

@@ -77,9 +77,12 @@ struct Progress {
 // shot::Request extends it (slicing to it is how the shot API hands a request down).
 struct RunOptions {
   int first_frame = -1, last_frame = -1;  // -1: the shot's range
-  std::vector<std::string> layers;        // empty: all
-  bool force = false;                     // synthesize again even when finished
-  bool composite = true;                  // false: layers only (a farm's layer task)
+  // >= 0: the temporal chain starts at this frame (at most first_frame), which runs as the
+  // shot's first frame does (emaki lookdev --temporal); -1: at the shot's first frame.
+  int chain_from = -1;
+  std::vector<std::string> layers;  // empty: all
+  bool force = false;               // synthesize again even when finished
+  bool composite = true;            // false: layers only (a farm's layer task)
   bool error_maps = false;  // each synthesized layer frame's error map, to Store::write_qa_map
   std::function<void(const Progress&)> progress;
   // Polled during each synthesis (synth::Params::cancel): true stops the run with
