@@ -105,8 +105,9 @@ class PyShot {
                        [&] { return shot::composite(shot_, r).composited; });
   }
 
-  py::dict flicker(const std::string& layer, const py::object& frames) {
-    const shot::Request r = request(frames, py::none());
+  py::dict flicker(const std::string& layer, const py::object& frames, bool maps) {
+    shot::Request r = request(frames, py::none());
+    r.qa_maps = maps;
     const shot::FlickerResult f =
         without_gil(ErrorKind::kInput, kShotArgs, [&] { return shot::flicker(shot_, layer, r); });
     py::list per_frame;
@@ -309,9 +310,11 @@ void bind_shot(py::module_& m) {
           "Re-composites finished layers with the shot's colours, blends and paper; returns the "
           "frames written.")
       .def("flicker", &PyShot::flicker, py::arg("layer"), py::kw_only(),
-           py::arg("frames") = py::none(),
-           "flicker(self, layer, *, frames=None)\n--\n\nTemporal error of a finished layer over at "
-           "least two frames: {layer, frames, mean, objects, ground, per_frame}.")
+           py::arg("frames") = py::none(), py::arg("maps") = false,
+           "flicker(self, layer, *, frames=None, maps=False)\n--\n\nTemporal error of a finished "
+           "layer over at least two frames: {layer, frames, mean, objects, ground, per_frame}. "
+           "With maps=True also writes each frame's flicker map into the output folder "
+           "(qa/flicker/LAYER/, as `emaki qa flicker --maps`).")
       .def("plan", &PyShot::plan, py::kw_only(), py::arg("chunk") = 8, py::arg("threads") = 1,
            py::arg("emaki") = "emaki",
            "plan(self, *, chunk=8, threads=1, emaki='emaki')\n--\n\nThe render-farm task graph "

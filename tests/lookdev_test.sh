@@ -2,7 +2,8 @@
 # emaki lookdev end to end: a small Fox shot (96x54, --scale 1), a first run, then a burst of
 # ten saves of the painting 50 ms apart. The frame on the page must change (the status's
 # generation moves on, the composite file is rewritten) and the burst must start at most two
-# runs (finished ones, plus any stopped by a newer save). Exit 77 (skip) without curl.
+# runs (finished ones, plus any stopped by a newer save); the frame made then from the inputs
+# kept in memory is byte for byte a fresh lookdev's. Exit 77 (skip) without curl.
 #   sh lookdev_test.sh SOURCE_DIR EMAKI WORK
 set -e
 src=$1 emaki=$2 work=$3
@@ -45,5 +46,36 @@ echo "burst of 10 saves: $runs runs; generation $(status)"
 [ "$before" != "$after" ] || { echo "FAIL: the preview frame was not made again"; exit 1; }
 [ $runs -ge 1 ] && [ $runs -le 2 ] || { echo "FAIL: $runs runs for one burst"; cat "$work/log"; exit 1; }
 kill $pid && wait $pid || { echo "FAIL: lookdev did not stop cleanly on SIGTERM"; exit 1; }
+# The frame made after the saves, from what the runs kept in memory, is the frame a fresh
+# lookdev of the saved painting makes.
+port=$((port + 1))
+"$emaki" lookdev "$work/shot.toml" --frames 0 --scale 1 --port "$port" --out "$work/fresh" \
+  > "$work/url" 2> "$work/log" &
+pid=$!
+wait_for '"generation":1,'
+kill $pid && wait $pid || { echo "FAIL: the fresh lookdev did not stop cleanly"; exit 1; }
+for f in composite/frame_0000.png layers/base/base_0000.exr layers/outline/outline_0000.exr; do
+  cmp -s "$work/out.lookdev/$f" "$work/fresh/$f" || { echo "FAIL: $f differs from a fresh run"; exit 1; }
+done
+# --temporal: frame 3 from frame 2 made as a chain's first frame, nothing before it; frame 2
+# is frame by frame's, frame 3 is not.
+one_run() {  # OUT_DIR, then lookdev's own options
+  out=$1; shift
+  port=$((port + 1))
+  "$emaki" lookdev "$work/shot.toml" --scale 1 --port "$port" --out "$out" "$@" \
+    > "$work/url" 2> "$work/log" &
+  pid=$!
+  wait_for '"generation":1,'
+  kill $pid && wait $pid || { echo "FAIL: lookdev $* did not stop cleanly"; exit 1; }
+}
+one_run "$work/temporal" --frames 3 --temporal
+one_run "$work/by_frame" --frames 2,3
+[ ! -e "$work/temporal/layers/base/base_0001.exr" ] || { echo "FAIL: --temporal made frame 1"; exit 1; }
+for l in base shadow outline; do
+  cmp -s "$work/temporal/layers/$l/${l}_0002.exr" "$work/by_frame/layers/$l/${l}_0002.exr" ||
+    { echo "FAIL: --temporal's frame 2 ($l) is not frame by frame's"; exit 1; }
+done
+! cmp -s "$work/temporal/layers/base/base_0003.exr" "$work/by_frame/layers/base/base_0003.exr" ||
+  { echo "FAIL: --temporal's frame 3 did not use the chain"; exit 1; }
 trap - EXIT
 echo "ok"

@@ -162,6 +162,12 @@ TEST_F(OutputSafety, HiddenUserFilesInTheOutputFolderSurvive) {
   write_text(dir_ / "composite/.frame_0000.tmp42.png", "old-style name, not ours to judge\n");
   // A temporary a killed emaki left behind: removed.
   write_text(dir_ / "composite/.frame_0000.emaki-tmp-0123456789abcdef.png", "left over\n");
+  // ... also beside the QA maps (qa/KIND/LAYER/), but not in a linked folder there.
+  fs::create_directories(dir_ / "qa/error/base");
+  write_text(dir_ / "qa/error/base/.frame_0000.emaki-tmp-0123456789abcdef.png", "left over\n");
+  fs::create_directories(dir_ / "elsewhere");
+  write_text(dir_ / "elsewhere/.frame_0000.emaki-tmp-0123456789abcdef.png", "not here\n");
+  fs::create_directory_symlink(dir_ / "elsewhere", dir_ / "qa/error/linked");
   // A symlink with emaki's pattern is never removed (nor its target touched).
   write_text(dir_ / "victim.txt", "precious\n");
   fs::create_symlink(dir_ / "victim.txt",
@@ -173,6 +179,8 @@ TEST_F(OutputSafety, HiddenUserFilesInTheOutputFolderSurvive) {
   EXPECT_EQ(slurp(dir_ / ".notes.emaki-tmp-0123456789abcdef.txt"), "mine\n");
   EXPECT_TRUE(fs::exists(dir_ / "composite/.frame_0000.tmp42.png"));
   EXPECT_FALSE(fs::exists(dir_ / "composite/.frame_0000.emaki-tmp-0123456789abcdef.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "qa/error/base/.frame_0000.emaki-tmp-0123456789abcdef.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "elsewhere/.frame_0000.emaki-tmp-0123456789abcdef.png"));
   EXPECT_TRUE(fs::is_symlink(dir_ / "composite/.frame_0001.emaki-tmp-fedcba9876543210.png"));
   EXPECT_EQ(slurp(dir_ / "victim.txt"), "precious\n");
   EXPECT_TRUE(fs::is_regular_file(dir_ / "composite/frame_0001.png"));

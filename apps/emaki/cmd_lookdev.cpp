@@ -1,7 +1,9 @@
 // `emaki lookdev SHOT --frames 0,24,47 [--scale 0.5]`: a few frames of a shot at preview size,
 // made again whenever the painting(s), the shot file or the passes are saved, on emaki view's
-// page (src/view/). Frames run frame by frame (no temporal chain) into their own folder; a save
-// during a run stops it at the next layer-frame and the run starts over once the saves settle.
+// page (src/view/). Frames run frame by frame (no temporal chain), or with --temporal each from
+// its predecessor made frame by frame, into their own folder; a save
+// during a run stops it (within the synthesis in progress: the engine's cancel hook) and the run
+// starts over once the saves settle.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +21,7 @@
 #include "core/utf8.h"
 #include "shot/api.h"
 #include "shot/plan.h"
+#include "synth/synthesizer.h"
 #include "view/rerun.h"
 #include "view/server.h"
 
@@ -35,7 +38,8 @@ struct LookdevOptions {
   std::string shot;
   std::string frames = "";
   double scale = 0.5;
-  std::string out;  // default: the shot's output folder + ".lookdev"
+  std::string out;        // default: the shot's output folder + ".lookdev"
+  bool temporal = false;  // each frame made from its predecessor (the chain's first step)
 };
 
 std::vector<int> parse_frame_list(const std::string& text, const pipeline::Shot& shot) {
@@ -58,9 +62,10 @@ std::vector<int> parse_frame_list(const std::string& text, const pipeline::Shot&
   return frames;
 }
 
-// The shot as lookdev runs it: preview size, every layer frame by frame, its own folder, no
-// movie or contact sheet.
-pipeline::Shot preview_shot(const std::string& path, double scale, const std::string& out) {
+// The shot as lookdev runs it: preview size, every layer frame by frame unless `temporal`, its
+// own folder, no movie or contact sheet.
+pipeline::Shot preview_shot(const std::string& path, double scale, const std::string& out,
+                            bool temporal = false) {
   pipeline::Shot s = shot::open(path);
   if (scale != 1.0 && s.source.kind != pipeline::SourceKind::kScene)
     throw Error("--scale", "a shot of studio passes is previewed at their own size (--scale 1)");
@@ -69,7 +74,8 @@ pipeline::Shot preview_shot(const std::string& path, double scale, const std::st
   s.source.render.width = s.source.width;
   s.source.render.height = s.source.height;
   s.source.render.outline_width = float(s.source.render.outline_width * scale);
-  for (pipeline::Layer& l : s.layers) l.temporal.enabled = false;
+  if (!temporal)
+    for (pipeline::Layer& l : s.layers) l.temporal.enabled = false;
   s.outputs.folder = out;
   s.outputs.mp4 = false;
   s.outputs.contact_sheet = false;
@@ -112,22 +118,27 @@ struct Status {
   }
 };
 
-// One run over the frames; returns whether it finished (not stale).
+// One run over the frames; returns whether it finished (not stale). `cache` keeps the inputs a
+// save did not change from one run to the next.
 bool run_frames(const LookdevOptions& o, const std::vector<int>& frames,
-                const std::atomic<bool>& stale, Status& status) {
+                const std::atomic<bool>& stale, Status& status, shot::InputCache& cache) {
   const auto t0 = std::chrono::steady_clock::now();
-  const pipeline::Shot s = preview_shot(o.shot, o.scale, o.out);
+  const pipeline::Shot s = preview_shot(o.shot, o.scale, o.out, o.temporal);
   for (const int f : frames) {
     if (stale) return false;
     shot::Request r;
     r.first_frame = r.last_frame = f;
+    // With --temporal, frame f - 1 as a chain's first frame and f from it along the chain.
+    if (o.temporal && f > s.source.first_frame) r.first_frame = r.chain_from = f - 1;
     r.force = true;
     r.previews = false;
+    r.error_maps = true;  // the page's overlay: where the painting has no good match
+    r.cancel = [&] { return stale.load(); };  // a save stops the synthesis in progress too
     r.progress = [&](const pipeline::Progress& p) {
       if (stale) throw StaleRun{};
       status.set(fmt::format("frame {} {}", p.frame, p.layer.empty() ? "compositing" : p.layer));
     };
-    shot::run(s, r);
+    shot::run(s, r, cache);
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -146,7 +157,8 @@ int run_lookdev(const Args& args) {
   CLI::App app{
       "Makes a few frames of a shot at preview size and makes them again on every save of the "
       "painting(s), the shot file or the passes; shows them on emaki view's page (its URL is "
-      "printed). Layers run frame by frame. Ctrl-C stops.",
+      "printed). Layers run frame by frame, or with --temporal each frame from its predecessor. "
+      "Ctrl-C stops.",
       "emaki lookdev"};
   LookdevOptions o;
   view::ServerOptions server_options;
@@ -154,6 +166,9 @@ int run_lookdev(const Args& args) {
   app.add_option("--frames", o.frames, "frames to make, e.g. 0,24,47 (default: the first)");
   app.add_option("--scale", o.scale, "preview size relative to the shot's (default 0.5)");
   app.add_option("--out", o.out, "output folder (default: the shot's, with '.lookdev')");
+  app.add_flag("--temporal", o.temporal,
+               "make each frame from its predecessor along the temporal chain (the frame before "
+               "is made frame by frame, and shown too): the chain's first step, at twice the cost");
   add_server_options(app, server_options);
   if (parse_cli(app, args)) return 0;
   if (!(o.scale > 0 && o.scale <= 1)) throw Error("--scale", "expected a number in (0, 1]");
@@ -165,10 +180,13 @@ int run_lookdev(const Args& args) {
   fs::create_directories(o.out);
   Status status;
   view::Server server({o.out}, server_options, [&] { return status.json(); });
+  shot::InputCache cache;  // used by the rerun's thread alone
   view::Rerun rerun(watched_files(shot), [&](const std::atomic<bool>& stale) {
     try {
-      run_frames(o, frames, stale, status);
+      run_frames(o, frames, stale, status, cache);
     } catch (const StaleRun&) {
+      status.set("a newer save: starting over");
+    } catch (const synth::Cancelled&) {
       status.set("a newer save: starting over");
     } catch (const std::exception& e) {
       status.set(std::string("error: ") + e.what());

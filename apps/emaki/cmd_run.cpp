@@ -53,6 +53,21 @@ void print_flicker(const pipeline::Shot& shot, const std::string& layer,
       by_id.c_str());
 }
 
+// --maps of emaki qa flicker|ghost.
+void bind_maps(CLI::App& app, const char* kind, bool& maps) {
+  app.add_flag("--maps", maps,
+               fmt::format("also write each frame's {} map into OUTPUT/qa/{}/LAYER/ (emaki "
+                           "view's overlay)",
+                           kind, kind));
+}
+
+void print_maps(const pipeline::Shot& shot, const char* kind, const std::string& layer,
+                const shot::Request& request) {
+  if (request.qa_maps)
+    std::fprintf(stderr, "emaki qa %s: maps in %s/qa/%s/%s/\n", kind, shot.outputs.folder.c_str(),
+                 kind, layer.c_str());
+}
+
 }  // namespace
 
 int run_run(const Args& args) {
@@ -68,11 +83,16 @@ int run_run(const Args& args) {
   app.add_flag("--force", force,
                "synthesize again frames that are already finished (outputs made with other "
                "settings are always redone)");
+  bool error_maps = false;
+  app.add_flag("--error-maps", error_maps,
+               "also write each synthesized layer frame's synthesis error map into "
+               "OUTPUT/qa/error/LAYER/ (emaki view's overlay)");
   c.bind_previews(app);
   if (parse_cli(app, args)) return 0;
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request request = c.request("run");
   request.force = force;
+  request.error_maps = error_maps;
   const shot::RunResult r = shot::run(shot, request);
   end_progress_line();
   std::fprintf(stderr,
@@ -125,11 +145,13 @@ int run_qa_flicker(const Args& args) {
   std::string layer;
   c.bind(app, "FIRST-LAST (default: all)");
   app.add_option("--layer", layer, "the layer to measure")->required();
+  bind_maps(app, "flicker", c.request_maps);
   if (parse_cli(app, args)) return 0;
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request request = c.request("qa");
   request.progress = nullptr;
   print_flicker(shot, layer, shot::flicker(shot, layer, request));
+  print_maps(shot, "flicker", layer, request);
   return 0;
 }
 
@@ -145,11 +167,13 @@ int run_qa_ghost(const Args& args) {
   std::string layer;
   c.bind(app, "FIRST-LAST (default: all)");
   app.add_option("--layer", layer, "the layer to measure")->required();
+  bind_maps(app, "ghost", c.request_maps);
   if (parse_cli(app, args)) return 0;
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request request = c.request("qa");
   request.progress = nullptr;
   const shot::GhostResult r = shot::ghost(shot, layer, request);
+  print_maps(shot, "ghost", layer, request);
   std::printf("%-6s %9s %12s %12s %14s\n", "frame", "hidden", "ghost share", "diff hidden",
               "diff visible");
   for (const pipeline::FrameGhost& f : r.frames)
@@ -169,7 +193,8 @@ int run_qa_ghost(const Args& args) {
 }  // namespace
 
 int run_qa(const Args& args) {
-  const std::string usage = "usage: emaki qa flicker|ghost SHOT --layer NAME [--frames A-B]";
+  const std::string usage =
+      "usage: emaki qa flicker|ghost SHOT --layer NAME [--frames A-B] [--maps]";
   if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
     std::printf(
         "Quality checks of a finished layer.\n%s\n\n"

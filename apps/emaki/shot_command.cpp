@@ -98,6 +98,7 @@ shot::Request ShotCommand::request(const char* command) const {
   }
   r.layers = split_commas(layers);
   r.previews = !no_previews;
+  r.qa_maps = request_maps;
   r.threads = threads;
   if (!max_memory.empty()) r.max_memory_mb = parse_memory_mb("--max-memory", max_memory);
   r.progress = progress_printer(command);

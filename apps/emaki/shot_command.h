@@ -28,6 +28,7 @@ struct ShotCommand {
   std::string shot_path, frames, layers;
   std::string max_memory;
   bool no_previews = false;
+  bool request_maps = false;  // qa --maps: shot::Request::qa_maps
   int threads = -1;
 
   // The shot file, --frames (its help text given), --threads and --max-memory.

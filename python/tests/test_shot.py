@@ -81,8 +81,10 @@ def test_composite_flicker_and_plan(tmp_path):
     shot = emaki.Shot.from_dict(tiny(tmp_path / "out"))
     shot.run(previews=False)
     assert shot.composite(frames=(1, 2), previews=False) == 2
-    f = shot.flicker("base")
+    f = shot.flicker("base", maps=True)
     assert f["frames"] == (0, 2) and len(f["per_frame"]) == 2 and f["mean"] > 0
+    maps = sorted(p.name for p in (shot.output_folder / "qa" / "flicker" / "base").iterdir())
+    assert maps == ["frame_0001.png", "frame_0002.png"]
     plan = shot.plan(chunk=2)
     assert plan["format"] == "emaki-plan-1"
     kinds = [t["kind"] for t in plan["tasks"]]

@@ -2,23 +2,27 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/check.h"
 #include "core/error.h"
 #include "core/shot_keys.h"
+#include "pipeline/qa_maps.h"
 #include "render/passes.h"
 
 namespace emaki::pipeline {
 
 FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> prev,
-                           ImageView<const float> cp, ImageView<const float> pp, int mask_channel) {
+                           ImageView<const float> cp, ImageView<const float> pp, int mask_channel,
+                           Image<float>* map) {
   CHECK_EQ(cur.width, prev.width);
   CHECK_EQ(cur.height, prev.height);
   CHECK_EQ(cp.width, cur.width);
   CHECK_EQ(pp.width, cur.width);
   FrameFlicker out;
   const int w = cur.width, h = cur.height;
+  if (map) *map = empty_qa_map(w, h);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const float* p = cp.at(x, y);
@@ -42,6 +46,10 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
         }
       if (!ok) continue;
       const double e = std::abs(double(cur(x, y, 0)) - v);
+      if (map) {
+        (*map)(x, y, 0) = float(std::min(1.0, e / kFlickerMapScale));
+        (*map)(x, y, 1) = 1.0f;
+      }
       out.all.sum += e, ++out.all.pixels;
       FlickerStats& s = id >= 2.0f ? out.objects : out.ground;
       s.sum += e, ++s.pixels;
@@ -53,7 +61,8 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
 
 SequenceFlicker measure_flicker(const Layer& layer, const FrameSource& frames, const Store& store,
                                 int first, int last,
-                                const std::function<void(const FrameFlicker&)>& each) {
+                                const std::function<void(const FrameFlicker&)>& each,
+                                const std::function<void(int, const Image<float>&)>& maps) {
   CHECK_LT(first, last);
   for (int f = first; f <= last; ++f)
     if (!store.has_layer(layer, f))
@@ -64,10 +73,12 @@ SequenceFlicker measure_flicker(const Layer& layer, const FrameSource& frames, c
   for (int f = first + 1; f <= last; ++f) {
     Image<float> cur = store.read_layer(layer, f), cur_passes = frames.passes(f);
     const int mask_channel = cur.channels() > value_channels ? value_channels : -1;
+    Image<float> map;
     FrameFlicker ff = frame_flicker(cur.cview(), prev.cview(), cur_passes.cview(),
-                                    prev_passes.cview(), mask_channel);
+                                    prev_passes.cview(), mask_channel, maps ? &map : nullptr);
     ff.frame = f;
     if (each) each(ff);
+    if (maps) maps(f, map);
     mean.add(ff);
     prev = std::move(cur);
     prev_passes = std::move(cur_passes);

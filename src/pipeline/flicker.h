@@ -43,15 +43,20 @@ struct SequenceFlicker {
 // channel `mask_channel`, -1 for none); passes in the layout of render/passes.h. A pixel counts
 // when it and the four pixels it samples in t-1 are fully covered, carry the same object id, no
 // line (silhouettes are where points hide) and, for a masked layer, lie inside both masks.
+// With `map`, it is made the frame's flicker map (pipeline/qa_maps.h): each counted pixel's
+// difference.
 FrameFlicker frame_flicker(ImageView<const float> current, ImageView<const float> previous,
                            ImageView<const float> current_passes,
-                           ImageView<const float> previous_passes, int mask_channel);
+                           ImageView<const float> previous_passes, int mask_channel,
+                           Image<float>* map = nullptr);
 
 // The flicker of `layer`'s finished frames [first, last] (first < last) in `store`, with the
-// passes of `frames`; `each` (may be empty) sees each frame's figures in frame order. Throws
-// emaki::Error naming the layer ("layers.NAME") when a frame is not synthesized yet.
+// passes of `frames`; `each` (may be empty) sees each frame's figures in frame order, and `maps`
+// (may be empty) each frame's flicker map. Throws emaki::Error naming the layer ("layers.NAME")
+// when a frame is not synthesized yet.
 SequenceFlicker measure_flicker(const Layer& layer, const FrameSource& frames, const Store& store,
                                 int first, int last,
-                                const std::function<void(const FrameFlicker&)>& each);
+                                const std::function<void(const FrameFlicker&)>& each,
+                                const std::function<void(int, const Image<float>&)>& maps = {});
 
 }  // namespace emaki::pipeline

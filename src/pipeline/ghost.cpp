@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/check.h"
 #include "core/error.h"
 #include "core/shot_keys.h"
+#include "pipeline/qa_maps.h"
 #include "pipeline/temporal_guide.h"
 #include "render/passes.h"
 
@@ -34,7 +36,7 @@ Image<float> window_mean(const Image<float>& w, int patch_size) {
 FrameGhost frame_ghost(const Layer& layer, ImageView<const float> current,
                        ImageView<const float> previous, ImageView<const float> reference,
                        ImageView<const float> passes, ImageView<const float> previous_passes,
-                       int frame) {
+                       int frame, Image<float>* map) {
   const int w = current.width, h = current.height;
   CHECK_EQ(reference.width, w);
   CHECK_EQ(passes.width, w);
@@ -55,6 +57,7 @@ FrameGhost frame_ghost(const Layer& layer, ImageView<const float> current,
   }
   FrameGhost out;
   out.frame = frame;
+  if (map) *map = empty_qa_map(w, h);
   GhostStats& s = out.stats;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -68,7 +71,12 @@ FrameGhost frame_ghost(const Layer& layer, ImageView<const float> current,
         continue;
       }
       ++s.hidden;
-      s.foreign_sum += double(adv.foreign(x, y)) * weight(x, y);
+      const double pull = double(adv.foreign(x, y)) * weight(x, y);
+      s.foreign_sum += pull;
+      if (map) {
+        (*map)(x, y, 0) = float(std::clamp(pull, 0.0, 1.0));
+        (*map)(x, y, 1) = 1.0f;
+      }
       s.diff_sum += diff;
     }
   return out;
@@ -76,7 +84,8 @@ FrameGhost frame_ghost(const Layer& layer, ImageView<const float> current,
 
 GhostStats measure_ghost(const Layer& layer, const FrameSource& frames, const Store& store,
                          int first, int last, const std::function<Image<float>(int)>& reference,
-                         const std::function<void(const FrameGhost&)>& each) {
+                         const std::function<void(const FrameGhost&)>& each,
+                         const std::function<void(int, const Image<float>&)>& maps) {
   CHECK_LT(first, last);
   if (!layer.temporal.enabled)
     throw Error(shot_keys::layer(layer.name),
@@ -89,9 +98,12 @@ GhostStats measure_ghost(const Layer& layer, const FrameSource& frames, const St
   for (int f = first + 1; f <= last; ++f) {
     Image<float> cur = store.read_layer(layer, f), cur_passes = frames.passes(f);
     const Image<float> ref = reference(f);
-    const FrameGhost fg = frame_ghost(layer, cur.cview(), prev.cview(), ref.cview(),
-                                      cur_passes.cview(), prev_passes.cview(), f);
+    Image<float> map;
+    const FrameGhost fg =
+        frame_ghost(layer, cur.cview(), prev.cview(), ref.cview(), cur_passes.cview(),
+                    prev_passes.cview(), f, maps ? &map : nullptr);
     if (each) each(fg);
+    if (maps) maps(f, map);
     total.add(fg.stats);
     prev = std::move(cur);
     prev_passes = std::move(cur_passes);

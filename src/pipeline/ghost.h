@@ -42,18 +42,20 @@ struct FrameGhost {
 // layer, lie inside its mask; hidden ones are those whose surface point was not visible at t-1
 // (temporal::visible_before: motion, object id and rest position). A pixel's weight is the
 // mean of the temporal guide's weight map (the confidence; 1 without it) over the patch around
-// it: the share of the patches voting it that carry the guide.
+// it: the share of the patches voting it that carry the guide. With `map`, it is made the
+// frame's ghost map (pipeline/qa_maps.h): each hidden pixel's foreign share times that weight.
 FrameGhost frame_ghost(const Layer& layer, ImageView<const float> current,
                        ImageView<const float> previous, ImageView<const float> reference,
                        ImageView<const float> passes, ImageView<const float> previous_passes,
-                       int frame);
+                       int frame, Image<float>* map = nullptr);
 
 // Frames first + 1 .. last of `layer` in `store` (first < last), against `reference(f)`, the
-// frame-by-frame result of frame f; `each` (may be empty) sees each frame's figures. Throws
-// emaki::Error naming the layer when a frame is not synthesized yet or the layer is not
-// temporal.
+// frame-by-frame result of frame f; `each` (may be empty) sees each frame's figures, `maps` (may
+// be empty) each frame's ghost map. Throws emaki::Error naming the layer when a frame is not
+// synthesized yet or the layer is not temporal.
 GhostStats measure_ghost(const Layer& layer, const FrameSource& frames, const Store& store,
                          int first, int last, const std::function<Image<float>(int)>& reference,
-                         const std::function<void(const FrameGhost&)>& each);
+                         const std::function<void(const FrameGhost&)>& each,
+                         const std::function<void(int, const Image<float>&)>& maps = {});
 
 }  // namespace emaki::pipeline

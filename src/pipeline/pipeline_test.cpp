@@ -9,6 +9,7 @@
 #include "pipeline/frames.h"
 #include "pipeline/run.h"
 #include "render/passes.h"
+#include "synth/synthesizer.h"
 
 namespace emaki::pipeline {
 namespace {
@@ -317,6 +318,24 @@ TEST(Pipeline, UnknownLayerOptionIsAnError) {
   } catch (const Error& e) {
     EXPECT_EQ(e.field(), "layers");  // a neutral name: each front end re-spells it
   }
+}
+
+// RunOptions::cancel reaches the synthesis: asked after the first layer frame, the run stops
+// inside the second with synth::Cancelled, the first written; never asked, nothing changes.
+TEST(Pipeline, CancelStopsTheSynthesisInProgress) {
+  const Shot shot = tiny_shot();
+  const SlidingFrames frames(40, 30);
+  MemoryStore store, plain, polled;
+  RunOptions o;
+  o.cancel = [&] { return store.layers.size() >= 1; };
+  EXPECT_THROW(run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, store, o),
+               synth::Cancelled);
+  EXPECT_EQ(store.layers.size(), 1u);
+  run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, plain, RunOptions{});
+  RunOptions never;
+  never.cancel = [] { return false; };
+  run_shot(shot, frames, tiny_exemplar(), CompositeInputs{}, polled, never);
+  for (int f = 0; f <= 3; ++f) EXPECT_TRUE(same_layer(plain, polled, f)) << f;
 }
 
 TEST(Pipeline, ContactSheetGrid) {

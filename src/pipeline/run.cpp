@@ -12,6 +12,7 @@
 #include "core/fnv.h"
 #include "core/rng.h"
 #include "core/shot_keys.h"
+#include "pipeline/qa_maps.h"
 #include "pipeline/temporal_guide.h"
 #include "pipeline/tone_anchor.h"
 #include "render/passes.h"
@@ -29,8 +30,9 @@ using Clock = std::chrono::steady_clock;
 struct PreparedLayer {
   const Layer* layer = nullptr;
   int value_channels = 1;
-  Image<float> style;                             // A': the touch (1 channel) or the painting's RGB
-  std::vector<Image<float>> source_guides;        // one per layer->guides entry
+  Image<float> style;  // A': the touch (1 channel) or the painting's RGB
+  // One per layer->guides entry: ExemplarImages::guides' or cut here.
+  std::vector<std::shared_ptr<const Image<float>>> source_guides;
   std::vector<const Image<float>*> painted_maps;  // per guide: its painted weight map, or null
   Image<float> temporal_style;  // A' low-passed for the temporal guide (guide_sigma), or empty
   AnchorExemplar anchor;        // the tone anchor's exemplar side (TemporalSpec::anchor), or empty
@@ -49,7 +51,11 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     p.style = extract(ex.painting.cview(), 0, 3);
   }
   for (const GuideSpec& g : layer.guides) {
-    p.source_guides.push_back(extract_pass(ex.passes.cview(), g.pass));
+    const auto cut = ex.guides.find(g.pass);
+    p.source_guides.push_back(
+        cut != ex.guides.end()
+            ? cut->second
+            : std::make_shared<const Image<float>>(extract_pass(ex.passes.cview(), g.pass)));
     const auto it = g.map_image.empty() ? maps.end() : maps.find(g.map_image);
     CHECK(g.map_image.empty() || it != maps.end());  // shot::load_weight_maps read every one
     p.painted_maps.push_back(it == maps.end() ? nullptr : &it->second);
@@ -58,7 +64,7 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     p.temporal_style = temporal::low_pass(p.style.cview(), layer.temporal.guide_sigma);
   if (layer.temporal.enabled && layer.temporal.anchor > 0) {
     std::vector<synth::Plane> sources;
-    for (const Image<float>& g : p.source_guides) sources.push_back(g.cview());
+    for (const auto& g : p.source_guides) sources.push_back(g->cview());
     p.anchor = anchor_exemplar(p.style.cview(), sources, layer.temporal.anchor);
   }
   return p;
@@ -69,6 +75,7 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
 struct LayerFrame {
   Image<float> value;
   Image<int32_t> nnf;
+  Image<float> error;  // when asked: the synthesis error (synth::Result::error)
 };
 
 // The main transfer's schedule with a warm start, unless the layer sets its own counts (which
@@ -151,10 +158,12 @@ Image<int32_t> anchor_layer(const PreparedLayer& p, int frame, const synth::Para
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
 // temporal chain continues; `previous_nnf`: the field of t-1 (empty: none, the whole pyramid
-// runs). `fields`: the frame's advection fields, shared by its layers.
+// runs). `fields`: the frame's advection fields, shared by its layers. `o`: the run's error
+// maps and cancel hook, if any.
 LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passes, int frame,
                             const Image<float>* previous, const Image<float>* previous_passes,
-                            ImageView<const int32_t> previous_nnf, AdvectionFields* fields) {
+                            ImageView<const int32_t> previous_nnf, AdvectionFields* fields,
+                            const RunOptions* o = nullptr) {
   const Layer& l = *p.layer;
   const Image<float> mask = layer_mask(passes, l.mask);
   const int n = p.value_channels;
@@ -163,7 +172,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     for (int y = 0; y < mask.height() && !any; ++y)
       for (int x = 0; x < mask.width() && !any; ++x) any = mask(x, y) > 0.5f;
     if (!any)  // nothing to synthesize: transparent, and no field
-      return {Image<float>(passes.width, passes.height, n + 1), {}};
+      return {Image<float>(passes.width, passes.height, n + 1), {}, {}};
   }
   std::vector<Image<float>> targets, pass_maps;
   targets.reserve(l.guides.size());  // views point into them: no reallocation
@@ -174,7 +183,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   for (std::size_t i = 0; i < l.guides.size(); ++i) {
     const GuideSpec& g = l.guides[i];
     targets.push_back(extract_pass(passes, g.pass));
-    synth::GuidePair pair{shot_keys::layer_guide(l.name, g.pass), p.source_guides[i].cview(),
+    synth::GuidePair pair{shot_keys::layer_guide(l.name, g.pass), p.source_guides[i]->cview(),
                           targets.back().cview(), g.weight};
     if (!g.map_pass.empty()) {
       pass_maps.push_back(extract_pass(passes, g.map_pass));
@@ -192,6 +201,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
                        inputs);
   if (!mask.empty()) inputs.target_mask = mask.cview();
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
+  if (o) params.cancel = o->cancel;
   const Image<int32_t> anchor_nnf =
       advected.value.empty() ? Image<int32_t>{}
                              : anchor_layer(p, frame, params, mask, temporal_pair, inputs);
@@ -212,8 +222,9 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   }
   synth::OutputRequest request;
   request.nnf = l.temporal.enabled && l.temporal.warm_start;
+  request.error = o && o->error_maps;  // measured once the result is made: it does not change it
   synth::Result r = synth::synthesize(inputs, params, request);
-  return {std::move(r.image), std::move(r.nnf)};
+  return {std::move(r.image), std::move(r.nnf), std::move(r.error)};
 }
 
 std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<std::string>& names) {
@@ -295,7 +306,8 @@ class ShotRun {
     selected_ = selected_layers(shot, o.layers);
     for (const Layer* l : selected_)
       prepared_.push_back(prepare(*l, exemplars.at(l->exemplar), maps));
-    first_ = shot.source.first_frame;
+    first_ = o.chain_from < 0 ? shot.source.first_frame
+                              : std::clamp(o.chain_from, shot.source.first_frame, a_);
   }
 
   RunReport run() {
@@ -398,7 +410,12 @@ class ShotRun {
           previous && held_[i].frame == f - 1 ? held_[i].nnf.cview() : ImageView<const int32_t>{};
       tick(f, l.name);
       LayerFrame r = synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes,
-                                      previous_nnf, &fields);
+                                      previous_nnf, &fields, &o_);
+      if (!r.error.empty())
+        store_.write_qa_map("error", l, f,
+                            synthesis_error_map(r.error.cview(), r.value.cview(),
+                                                prepared_[i].value_channels, l.synth.patch_size)
+                                .cview());
       now[i].value = std::move(r.value);
       now[i].nnf = std::move(r.nnf);
       if (!now[i].nnf.empty())

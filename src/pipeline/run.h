@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,10 @@ namespace emaki::pipeline {
 // it was painted over (kChannelCount channels, the painting's size).
 struct ExemplarImages {
   Image<float> painting;
-  Image<float> passes;
+  Image<float> passes;  // may be empty when `guides` holds every pass its layers use
+  // Passes cut out of `passes` already (extract_pass), by pass name, which the layers take
+  // instead of cutting them again (shot/input_cache.h keeps them between runs).
+  std::map<std::string, std::shared_ptr<const Image<float>>> guides;
 };
 
 // Where layer results and frame outputs live. A layer frame is finished once has_layer says so:
@@ -49,6 +53,12 @@ class Store {
   }
   // Removes the layer's field at `frame`, if there is one (TemporalSpec::keep_every_field false).
   virtual void remove_field(const Layer& layer, int frame) { (void)layer, (void)frame; }
+  // A QA map of the layer at `frame` (pipeline/qa_maps.h), `kind` naming it: "error" (the
+  // synthesis error, RunOptions::error_maps), "flicker", "ghost". The default keeps nothing.
+  virtual void write_qa_map(const std::string& kind, const Layer& layer, int frame,
+                            ImageView<const float> map) {
+    (void)kind, (void)layer, (void)frame, (void)map;
+  }
   // True when every per-frame output (composite, layered EXR, ...) of `frame` exists.
   virtual bool has_frame(int frame) const = 0;
   // `composite` is RGBA; `layers` are in shot.layers order.
@@ -67,10 +77,17 @@ struct Progress {
 // shot::Request extends it (slicing to it is how the shot API hands a request down).
 struct RunOptions {
   int first_frame = -1, last_frame = -1;  // -1: the shot's range
-  std::vector<std::string> layers;        // empty: all
-  bool force = false;                     // synthesize again even when finished
-  bool composite = true;                  // false: layers only (a farm's layer task)
+  // >= 0: the temporal chain starts at this frame (at most first_frame), which runs as the
+  // shot's first frame does (emaki lookdev --temporal); -1: at the shot's first frame.
+  int chain_from = -1;
+  std::vector<std::string> layers;  // empty: all
+  bool force = false;               // synthesize again even when finished
+  bool composite = true;            // false: layers only (a farm's layer task)
+  bool error_maps = false;  // each synthesized layer frame's error map, to Store::write_qa_map
   std::function<void(const Progress&)> progress;
+  // Polled during each synthesis (synth::Params::cancel): true stops the run with
+  // synth::Cancelled, leaving the layer frames written before it; false changes nothing.
+  std::function<bool()> cancel;
 };
 
 struct RunReport {

@@ -2,15 +2,19 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
+
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
+#include "shot/input_cache.h"
 #include "shot/inputs.h"
 #include "shot/memory.h"
 #include "shot/parser.h"
 #include "shot/plan.h"
 #include "store/file_store.h"
 #include "store/previews.h"
+#include "store/qa_maps.h"
 
 namespace emaki::shot {
 
@@ -53,9 +57,10 @@ void check_peak_memory(const pipeline::Shot& shot, const Request& r, const char*
 // `rendered`: as load_exemplars takes it.
 Exemplars load_exemplars_checked(const pipeline::Shot& shot, const Request& r, const char* work,
                                  std::initializer_list<TaskKind> kinds,
-                                 std::vector<std::string>* rendered = nullptr) {
+                                 std::vector<std::string>* rendered = nullptr,
+                                 InputCache* cache = nullptr) {
   check_peak_memory(shot, r, work, kinds);
-  Exemplars exemplars = load_exemplars(shot, rendered);
+  Exemplars exemplars = load_exemplars(shot, rendered, cache);
   check_peak_memory(shot, r, work, kinds, exemplars);
   return exemplars;
 }
@@ -79,7 +84,9 @@ pipeline::Shot open_text(std::string_view text, const std::string& path) {
   return parse_shot(text, path);
 }
 
-RunResult run(const pipeline::Shot& shot, const Request& request) {
+namespace {
+
+RunResult run_with(const pipeline::Shot& shot, const Request& request, InputCache* cache) {
   pipeline::check_run_options(shot, run_options(request));
   const Scope scope(shot, request);
   // Everything that can fail on the inputs fails here, before a single output file exists.
@@ -88,16 +95,27 @@ RunResult run(const pipeline::Shot& shot, const Request& request) {
       shot, request, request.composite ? "the run" : "the layer task",
       {TaskKind::kLayer, request.composite ? TaskKind::kComposite : TaskKind::kLayer,
        TaskKind::kPasses},
-      &rendered);
-  const auto frames = open_frames(shot);
-  const pipeline::CompositeInputs ci = load_composite_inputs(shot);
-  const pipeline::WeightMapImages maps = load_weight_maps(shot);
+      &rendered, cache);
+  const auto frames = open_frames(shot, cache);
+  const pipeline::CompositeInputs ci = load_composite_inputs(shot, cache);
+  const pipeline::WeightMapImages maps = load_weight_maps(shot, cache);
+  if (cache) cache->drop_unused();
   RunResult out;
   io::FileStore store(shot, io::StoreMode::kRun, access(request));  // locked until the end
   keep_references(shot, exemplars, rendered);
   out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request), maps);
   out.previews = previews(shot, request);
   return out;
+}
+
+}  // namespace
+
+RunResult run(const pipeline::Shot& shot, const Request& request) {
+  return run_with(shot, request, nullptr);
+}
+
+RunResult run(const pipeline::Shot& shot, const Request& request, InputCache& cache) {
+  return run_with(shot, request, &cache);
 }
 
 CompositeResult composite(const pipeline::Shot& shot, const Request& request) {
@@ -180,6 +198,39 @@ const pipeline::Layer& measured_range(const pipeline::Shot& shot, const std::str
   return *l;
 }
 
+namespace {
+
+// A measure's maps written through `store` as they come (Request::qa_maps); when the measure
+// fails halfway, the destructor removes those written: no partial output.
+class MapWriter {
+ public:
+  MapWriter(io::FileStore& store, const char* kind, const pipeline::Layer& layer, bool wanted)
+      : store_(store), kind_(kind), layer_(layer), wanted_(wanted) {}
+  ~MapWriter() {
+    if (finished_) return;
+    std::error_code ec;
+    for (const std::string& f : written_) std::filesystem::remove(f, ec);
+  }
+  // The measure's callback, or none when no maps are wanted.
+  std::function<void(int, const Image<float>&)> callback() {
+    if (!wanted_) return {};
+    return [this](int frame, const Image<float>& map) {
+      written_.push_back(io::qa_map_png(store_.paths().folder, kind_, layer_.name, frame));
+      store_.write_qa_map(kind_, layer_, frame, map.cview());
+    };
+  }
+  void finish() { finished_ = true; }
+
+ private:
+  io::FileStore& store_;
+  const char* kind_;
+  const pipeline::Layer& layer_;
+  bool wanted_, finished_ = false;
+  std::vector<std::string> written_;
+};
+
+}  // namespace
+
 FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,
                       const Request& request) {
   const Scope scope(shot, request);
@@ -187,9 +238,11 @@ FlickerResult flicker(const pipeline::Shot& shot, const std::string& layer,
   const pipeline::Layer* l = &measured_range(shot, layer, request, out.first_frame, out.last_frame);
   const auto frames = open_frames(shot);
   io::FileStore store(shot, io::StoreMode::kReadFinished);
-  out.mean =
-      pipeline::measure_flicker(*l, *frames, store, out.first_frame, out.last_frame,
-                                [&](const pipeline::FrameFlicker& f) { out.frames.push_back(f); });
+  MapWriter writer(store, "flicker", *l, request.qa_maps);
+  out.mean = pipeline::measure_flicker(
+      *l, *frames, store, out.first_frame, out.last_frame,
+      [&](const pipeline::FrameFlicker& f) { out.frames.push_back(f); }, writer.callback());
+  writer.finish();
   return out;
 }
 
@@ -206,9 +259,11 @@ GhostResult ghost(const pipeline::Shot& shot, const std::string& layer, const Re
     return pipeline::synthesize_alone(l, exemplars.at(l.exemplar), frames->passes(f).cview(), f,
                                       maps);
   };
-  out.total =
-      pipeline::measure_ghost(l, *frames, store, out.first_frame, out.last_frame, reference,
-                              [&](const pipeline::FrameGhost& f) { out.frames.push_back(f); });
+  MapWriter writer(store, "ghost", l, request.qa_maps);
+  out.total = pipeline::measure_ghost(
+      l, *frames, store, out.first_frame, out.last_frame, reference,
+      [&](const pipeline::FrameGhost& f) { out.frames.push_back(f); }, writer.callback());
+  writer.finish();
   return out;
 }
 

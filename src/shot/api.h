@@ -14,6 +14,7 @@
 #include "pipeline/ghost.h"
 #include "pipeline/run.h"
 #include "pipeline/shot_description.h"
+#include "shot/input_cache.h"
 
 namespace emaki::shot {
 
@@ -33,6 +34,10 @@ struct Request : pipeline::RunOptions {
   // Refuse the work when its estimated peak memory exceeds this many MB (0: no limit but what
   // the machine has available, which is always checked).
   int64_t max_memory_mb = 0;
+  // flicker() and ghost(): also write each frame's map into the output folder, for emaki view's
+  // overlay (store/qa_maps.h: OUTPUT/qa/flicker/LAYER/, OUTPUT/qa/ghost/LAYER/). run(): see
+  // RunOptions::error_maps (OUTPUT/qa/error/LAYER/).
+  bool qa_maps = false;
 };
 
 struct RunResult {
@@ -43,6 +48,11 @@ struct RunResult {
 // Synthesizes, composites and writes the requested frames and layers, resuming after the last
 // finished frame. Every input is opened and checked before the first output is written.
 RunResult run(const pipeline::Shot& shot, const Request& request);
+// The same, with what `cache` holds of the shot's inputs (shot/input_cache.h) taken from it and
+// what this run reads kept in it: the run again after a save of the painting (emaki lookdev)
+// decodes the painting and synthesizes, but reads, decodes and renders nothing else again. The
+// files written are those of a run without the cache.
+RunResult run(const pipeline::Shot& shot, const Request& request, InputCache& cache);
 
 struct CompositeResult {
   int composited = 0;  // frames

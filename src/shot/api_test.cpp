@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "core/error.h"
@@ -139,6 +141,51 @@ TEST_F(ShotApi, RequestErrorsNameNeutralFields) {
   EXPECT_EQ(error_of([&] { flicker(shot, "base", one); }).field(), "frames");
   // Nothing was synthesized: flicker names the layer by its shot key.
   EXPECT_EQ(error_of([&] { flicker(shot, "base", Request{}); }).subject(), "layers.base");
+}
+
+std::string bytes_of(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The QA maps (store/qa_maps.h): one PNG per measured frame under qa/KIND/LAYER/, the same bytes
+// every time, not all black; a measure refused writes none.
+TEST_F(ShotApi, QaMapsAreWrittenPerFrameTheSameEachTime) {
+  const pipeline::Shot shot = tiny();
+  Request maps;
+  maps.qa_maps = true;
+  EXPECT_EQ(error_of([&] { flicker(shot, "base", maps); }).subject(), "layers.base");
+  EXPECT_FALSE(fs::exists(folder_ / "qa"));
+  Request r;
+  r.previews = false;
+  r.error_maps = true;
+  run(shot, r);
+  flicker(shot, "base", maps);
+  ghost(shot, "base", maps);
+  const fs::path qa = folder_ / "qa";
+  for (const char* layer : {"base", "ink"})
+    for (const char* f : {"frame_0000.png", "frame_0001.png", "frame_0002.png"})
+      EXPECT_TRUE(fs::exists(qa / "error" / layer / f)) << layer << " " << f;
+  for (const char* kind : {"flicker", "ghost"}) {
+    EXPECT_FALSE(fs::exists(qa / kind / "base" / "frame_0000.png"));  // no frame before it
+    EXPECT_TRUE(fs::exists(qa / kind / "base" / "frame_0002.png"));
+  }
+  const Image<float> error = io::read_image_float((qa / "error/base/frame_0001.png").string());
+  double sum = 0;
+  for (int y = 0; y < error.height(); ++y)
+    for (int x = 0; x < error.width(); ++x) sum += error(x, y, 0) + error(x, y, 2);
+  EXPECT_GT(sum, 0.0);
+  const std::string flicker_map = bytes_of(qa / "flicker/base/frame_0001.png");
+  const std::string ghost_map = bytes_of(qa / "ghost/base/frame_0002.png");
+  const std::string error_map = bytes_of(qa / "error/ink/frame_0001.png");
+  flicker(shot, "base", maps);
+  ghost(shot, "base", maps);
+  r.force = true;
+  r.threads = 1;  // the maps do not depend on the thread count either
+  run(shot, r);
+  EXPECT_TRUE(bytes_of(qa / "flicker/base/frame_0001.png") == flicker_map);
+  EXPECT_TRUE(bytes_of(qa / "ghost/base/frame_0002.png") == ghost_map);
+  EXPECT_TRUE(bytes_of(qa / "error/ink/frame_0001.png") == error_map);
 }
 
 }  // namespace

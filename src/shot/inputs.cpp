@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <functional>
 #include <mutex>
 #include <optional>
 
@@ -16,6 +17,7 @@
 #include "store/frame_sequence.h"
 #include "store/output_store.h"
 #include "store/reference_cache.h"
+#include "store/settings_manifests.h"
 
 namespace emaki::shot {
 
@@ -46,14 +48,32 @@ std::optional<std::string> input_bytes(const std::string& path) {
   return io::read_input_file(path, kMaxInputBytes);
 }
 
-Image<float> read_input_image(const std::string& path, const ReadOptions& options = {}) {
-  if (const std::optional<std::string> bytes = input_bytes(path))
-    return io::read_image_memory(bytes->data(), bytes->size(), path, options).to_float();
+Image<float> read_input_image(const std::string& path, const std::optional<std::string>& bytes,
+                              const ReadOptions& options = {}) {
+  if (bytes) return io::read_image_memory(bytes->data(), bytes->size(), path, options).to_float();
   return io::read_image_float(path, options);
 }
 
-Image<float> rgb_of(const std::string& key, const std::string& path) {
-  Image<float> img = read_input_image(path);
+// What `decode` makes of the file at `path` (given its bytes, or nullopt when they are left to a
+// reader that takes the path), taken from `cache` when the file holds the bytes of one decoded
+// before. `kind` tells apart what different decoders make of one file.
+Image<float> decoded(InputCache* cache, const std::string& kind, const std::string& path,
+                     const std::function<Image<float>(const std::optional<std::string>&)>& decode) {
+  if (!cache) return decode(input_bytes(path));
+  const std::string prefix = kind + "|" + path + "|";
+  if (const auto kept = cache->find(prefix + io::file_digest(path))) return kept->clone();
+  // The key is the digest of the very bytes decoded: a file saved again meanwhile misses next
+  // time instead of finding this image under its new digest.
+  const std::optional<std::string> bytes = input_bytes(path);
+  Image<float> image = decode(bytes);
+  if (bytes) cache->keep(prefix + io::bytes_digest(*bytes), image.clone());
+  return image;
+}
+
+Image<float> rgb_of(const std::string& key, const std::string& path, InputCache* cache) {
+  Image<float> img = decoded(cache, "image", path, [&](const std::optional<std::string>& bytes) {
+    return read_input_image(path, bytes);
+  });
   if (img.channels() >= 3 && img.channels() <= 4) {
     if (img.channels() == 3) return img;
     Image<float> out(img.width(), img.height(), 3);
@@ -120,7 +140,7 @@ class LazySceneFrames final : public pipeline::FrameSource {
 
 }  // namespace
 
-std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
+std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot, InputCache* cache) {
   const pipeline::Source& s = shot.source;
   try {
     if (s.kind == pipeline::SourceKind::kSequence) {
@@ -128,91 +148,160 @@ std::unique_ptr<pipeline::FrameSource> open_frames(const Shot& shot) {
       if (shot.colour.get().is_identity(s.passes_colorspace, "scene_linear")) return frames;
       return std::make_unique<ColourConvertedFrames>(shot, std::move(frames));
     }
-    auto lazy = std::make_unique<LazySceneFrames>(s);
-    const LazySceneFrames* scene = lazy.get();
-    std::unique_ptr<pipeline::FrameSource> frames = io::with_pass_cache(shot, std::move(lazy));
-    // Without a current pass cache every frame is rendered: the scene is loaded now, so that a
-    // bad one fails before any output is written. With one, its passes were rendered from this
-    // very scene file (the cache's manifest holds its digest), and a farm task that only reads
-    // them (a layer or composite task) never parses the scene nor decodes its textures.
-    if (frames.get() == scene) scene->load();
-    return frames;
+    const auto open = [&]() -> std::unique_ptr<pipeline::FrameSource> {
+      auto lazy = std::make_unique<LazySceneFrames>(s);
+      const LazySceneFrames* scene = lazy.get();
+      std::unique_ptr<pipeline::FrameSource> frames = io::with_pass_cache(shot, std::move(lazy));
+      // Without a current pass cache every frame is rendered: the scene is loaded now, so that
+      // a bad one fails before any output is written. With one, its passes were rendered from
+      // this very scene file (the cache's manifest holds its digest), and a farm task that only
+      // reads them (a layer or composite task) never parses the scene nor decodes its textures.
+      if (frames.get() == scene) scene->load();
+      return frames;
+    };
+    if (!cache) return open();
+    // Everything that decides a frame's passes, the scene file's digest included.
+    std::string settings;
+    for (const std::string& line : io::passes_manifest(shot)) settings += line + "\n";
+    return cache->frames(settings, open);
   } catch (const Error& e) {
     rethrow_as_key(e, "source");
   }
 }
 
+namespace {
+
+// A MatCap-like exemplar's reference passes at w x h: from the shot's output folder when a task
+// or run kept them there (with `rendered`), else rendered (and then noted in `rendered`).
+Image<float> reference_passes(const Shot& shot, const pipeline::Exemplar& e, int w, int h,
+                              std::vector<std::string>* rendered) {
+  // Rendered once per shot: later tasks and runs read what the first one kept.
+  std::optional<Image<float>> kept;
+  if (rendered) kept = io::read_reference(shot.outputs.folder, io::reference_key(e, w, h), w, h);
+  if (!kept) {
+    try {
+      kept = pipeline::matcap_passes(e, w, h);
+    } catch (const Error& err) {
+      rethrow_as_key(err, "exemplars." + e.name);
+    }
+    if (rendered) rendered->push_back(e.name);
+  }
+  return std::move(*kept);
+}
+
+// A studio exemplar's pass file (`bytes`, or nullopt: read it by path) as kChannelCount channels
+// of w x h: the passes its layers use as guides, the rest zero.
+Image<float> studio_passes(const Shot& shot, const pipeline::Exemplar& e, int w, int h,
+                           const std::optional<std::string>& bytes) {
+  const std::string key = "exemplars." + e.name;
+  Image<float> passes(w, h, render::kChannelCount);
+  const std::vector<std::string> have =
+      bytes ? io::list_channels_memory(bytes->data(), bytes->size(), e.passes)
+            : io::list_channels(e.passes);
+  std::vector<std::string> names;  // the file's channels to read
+  std::vector<int> into;           // parallel: the channel of `passes` each fills
+  for (const pipeline::Layer& l : shot.layers) {
+    if (l.exemplar != e.name) continue;
+    for (const pipeline::GuideSpec& g : l.guides) {
+      const render::PassInfo* p = render::find_pass(g.pass);
+      std::vector<std::string> pass_names;
+      for (int c = 0; c < p->count; ++c)
+        pass_names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
+      // tools/blender/emaki_passes.py writes a single-channel pass as NAME.V.
+      const std::string value = std::string(p->name) + ".V";
+      if (p->count == 1 && std::find(have.begin(), have.end(), pass_names[0]) == have.end() &&
+          std::find(have.begin(), have.end(), value) != have.end())
+        pass_names = {value};
+      for (int c = 0; c < p->count; ++c) {
+        const std::string& n = pass_names[std::size_t(c)];
+        if (std::find(have.begin(), have.end(), n) == have.end())
+          throw Error(key + ".passes",
+                      fmt::format("channel '{}' (guide '{}' of layer '{}') is not in '{}'", n,
+                                  g.pass, l.name, e.passes));
+        if (std::find(into.begin(), into.end(), p->first + c) != into.end()) continue;
+        names.push_back(n);
+        into.push_back(p->first + c);
+      }
+    }
+  }
+  if (!names.empty()) {
+    const Image<float> pass =
+        bytes ? io::read_image_memory(bytes->data(), bytes->size(), e.passes, ReadOptions{names})
+                    .to_float()
+              : io::read_image_float(e.passes, ReadOptions{names});
+    if (pass.width() != w || pass.height() != h)
+      throw Error(key + ".passes",
+                  fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}", e.passes, pass.width(),
+                              pass.height(), e.painting, w, h));
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (std::size_t i = 0; i < into.size(); ++i) passes(x, y, into[i]) = pass(x, y, int(i));
+  }
+  return passes;
+}
+
+// The passes the layers of exemplar `e` use as guides.
+std::vector<std::string> guide_passes(const Shot& shot, const pipeline::Exemplar& e) {
+  std::vector<std::string> out;
+  for (const pipeline::Layer& l : shot.layers)
+    if (l.exemplar == e.name)
+      for (const pipeline::GuideSpec& g : l.guides)
+        if (std::find(out.begin(), out.end(), g.pass) == out.end()) out.push_back(g.pass);
+  return out;
+}
+
+// Fills im.guides from `cache` when it holds every guide of `e`'s layers cut from the passes
+// `from` names; the passes themselves are then not needed.
+bool kept_guides(const Shot& shot, const pipeline::Exemplar& e, InputCache& cache,
+                 const std::string& from, pipeline::ExemplarImages& im) {
+  std::map<std::string, std::shared_ptr<const Image<float>>> guides;
+  for (const std::string& pass : guide_passes(shot, e)) {
+    auto kept = cache.find("guide|" + from + "|" + pass);
+    if (!kept) return false;
+    guides.emplace(pass, std::move(kept));
+  }
+  im.guides = std::move(guides);
+  return true;
+}
+
+// Cuts the guides of `e`'s layers out of im.passes into im.guides, and keeps them in `cache`.
+void keep_guides(const Shot& shot, const pipeline::Exemplar& e, InputCache& cache,
+                 const std::string& from, pipeline::ExemplarImages& im) {
+  for (const std::string& pass : guide_passes(shot, e))
+    im.guides[pass] =
+        cache.keep("guide|" + from + "|" + pass, pipeline::extract_pass(im.passes.cview(), pass));
+}
+
+}  // namespace
+
 std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
-                                                               std::vector<std::string>* rendered) {
+                                                               std::vector<std::string>* rendered,
+                                                               InputCache* cache) {
   std::map<std::string, pipeline::ExemplarImages> out;
   for (const pipeline::Exemplar& e : shot.exemplars) {
     const std::string key = "exemplars." + e.name;
     pipeline::ExemplarImages im;
-    im.painting = rgb_of(key + ".painting", e.painting);
+    im.painting = rgb_of(key + ".painting", e.painting, cache);
     shot.colour.get().convert(im.painting.view(), e.colorspace, "color_picking");
     const int w = im.painting.width(), h = im.painting.height();
-    if (e.kind == pipeline::ExemplarKind::kMatcap) {
-      // Rendered once per shot: later tasks and runs read what the first one kept.
-      std::optional<Image<float>> kept;
-      if (rendered)
-        kept = io::read_reference(shot.outputs.folder, io::reference_key(e, w, h), w, h);
-      if (kept) {
-        im.passes = std::move(*kept);
+    const bool matcap = e.kind == pipeline::ExemplarKind::kMatcap;
+    // With a cache, the guides its layers cut out of the passes, under what the passes are.
+    const auto from = [&](const std::string& digest) {
+      return matcap ? "reference " + io::reference_key(e, w, h)
+                    : fmt::format("passes {}x{} {} {}", w, h, e.passes, digest);
+    };
+    if (!(cache &&
+          kept_guides(shot, e, *cache, from(matcap ? "" : io::file_digest(e.passes)), im))) {
+      std::optional<std::string> bytes;  // a pass file's, read once for its digest and decoding
+      if (matcap) {
+        im.passes = reference_passes(shot, e, w, h, rendered);
       } else {
-        try {
-          im.passes = pipeline::matcap_passes(e, w, h);
-        } catch (const Error& err) {
-          rethrow_as_key(err, key);
-        }
-        if (rendered) rendered->push_back(e.name);
+        bytes = input_bytes(e.passes);
+        im.passes = studio_passes(shot, e, w, h, bytes);
       }
-    } else {
-      // The passes the layers use as guides, read in one go; the rest stay zero.
-      im.passes = Image<float>(w, h, render::kChannelCount);
-      const std::optional<std::string> bytes = input_bytes(e.passes);
-      const std::vector<std::string> have =
-          bytes ? io::list_channels_memory(bytes->data(), bytes->size(), e.passes)
-                : io::list_channels(e.passes);
-      std::vector<std::string> names;  // the file's channels to read
-      std::vector<int> into;           // parallel: the channel of im.passes each fills
-      for (const pipeline::Layer& l : shot.layers) {
-        if (l.exemplar != e.name) continue;
-        for (const pipeline::GuideSpec& g : l.guides) {
-          const render::PassInfo* p = render::find_pass(g.pass);
-          std::vector<std::string> pass_names;
-          for (int c = 0; c < p->count; ++c)
-            pass_names.push_back(fmt::format("{}.{}", p->name, p->suffixes[c]));
-          // tools/blender/emaki_passes.py writes a single-channel pass as NAME.V.
-          const std::string value = std::string(p->name) + ".V";
-          if (p->count == 1 && std::find(have.begin(), have.end(), pass_names[0]) == have.end() &&
-              std::find(have.begin(), have.end(), value) != have.end())
-            pass_names = {value};
-          for (int c = 0; c < p->count; ++c) {
-            const std::string& n = pass_names[std::size_t(c)];
-            if (std::find(have.begin(), have.end(), n) == have.end())
-              throw Error(key + ".passes",
-                          fmt::format("channel '{}' (guide '{}' of layer '{}') is not in '{}'", n,
-                                      g.pass, l.name, e.passes));
-            if (std::find(into.begin(), into.end(), p->first + c) != into.end()) continue;
-            names.push_back(n);
-            into.push_back(p->first + c);
-          }
-        }
-      }
-      if (!names.empty()) {
-        const Image<float> pass = bytes ? io::read_image_memory(bytes->data(), bytes->size(),
-                                                                e.passes, ReadOptions{names})
-                                              .to_float()
-                                        : io::read_image_float(e.passes, ReadOptions{names});
-        if (pass.width() != w || pass.height() != h)
-          throw Error(key + ".passes",
-                      fmt::format("'{}' is {}x{}, its painting '{}' is {}x{}", e.passes,
-                                  pass.width(), pass.height(), e.painting, w, h));
-        for (int y = 0; y < h; ++y)
-          for (int x = 0; x < w; ++x)
-            for (std::size_t i = 0; i < into.size(); ++i)
-              im.passes(x, y, into[i]) = pass(x, y, int(i));
-      }
+      // The key names the very bytes decoded: a file saved again meanwhile misses next time.
+      if (cache && (matcap || bytes))
+        keep_guides(shot, e, *cache, from(bytes ? io::bytes_digest(*bytes) : ""), im);
     }
     out.emplace(e.name, std::move(im));
   }
@@ -230,13 +319,16 @@ void keep_references(const Shot& shot,
   }
 }
 
-pipeline::WeightMapImages load_weight_maps(const Shot& shot) {
+pipeline::WeightMapImages load_weight_maps(const Shot& shot, InputCache* cache) {
   pipeline::WeightMapImages out;
   for (const pipeline::Layer& l : shot.layers)
     for (const pipeline::GuideSpec& g : l.guides) {
       if (g.map_image.empty() || out.count(g.map_image)) continue;
       const std::string key = fmt::format("layers.{}.guides.{}.map", l.name, g.pass);
-      const Image<float> img = io::read_image_float(g.map_image);
+      const Image<float> img =
+          decoded(cache, "image float", g.map_image, [&](const std::optional<std::string>& bytes) {
+            return read_input_image(g.map_image, bytes);
+          });
       if (img.width() != shot.source.width || img.height() != shot.source.height)
         throw Error(key, fmt::format("'{}' is {}x{}, the shot is {}x{}", g.map_image, img.width(),
                                      img.height(), shot.source.width, shot.source.height));
@@ -245,10 +337,10 @@ pipeline::WeightMapImages load_weight_maps(const Shot& shot) {
   return out;
 }
 
-pipeline::CompositeInputs load_composite_inputs(const Shot& shot) {
+pipeline::CompositeInputs load_composite_inputs(const Shot& shot, InputCache* cache) {
   pipeline::CompositeInputs ci;
   if (!shot.compositing.paper.empty()) {
-    ci.paper = rgb_of("compositing.paper", shot.compositing.paper);
+    ci.paper = rgb_of("compositing.paper", shot.compositing.paper, cache);
     shot.colour.get().convert(ci.paper.view(), shot.compositing.paper_colorspace, "color_picking");
   }
   return ci;

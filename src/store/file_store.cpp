@@ -15,6 +15,7 @@
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "store/field_file.h"
+#include "store/qa_maps.h"
 #include "store/settings_manifests.h"
 
 namespace emaki::io {
@@ -184,6 +185,17 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
   if (const fs::path refs = root / "references"; fs::is_directory(refs, ec))
     clean_up(refs,
              [](const std::string& t) { return t.ends_with(".exr") || t.ends_with(".digest"); });
+  // QA maps (store/qa_maps.h): qa/KIND/LAYER/frame_NNNN.png, in folders (never links) only.
+  const auto folders = [](const fs::path& dir) {
+    std::vector<fs::path> out;
+    std::error_code e;
+    for (fs::directory_iterator it(dir, e), end; !e && it != end; it.increment(e))
+      if (!it->is_symlink(e) && it->is_directory(e)) out.push_back(it->path());
+    return out;
+  };
+  for (const fs::path& kind : folders(root / "qa"))
+    for (const fs::path& layer : folders(kind))
+      clean_up(layer, [](const std::string& t) { return is_frame_name(t, "frame_", {".png"}); });
 }
 
 void FileStore::make_current(Manifested& m, const std::string& folder,
@@ -296,6 +308,12 @@ void FileStore::write_layer(const pipeline::Layer& layer, int frame, ImageView<c
   exr.format = SampleFormat::kFloat;  // full float: the temporal chain resumes from it bit for bit
   exr.channel_names = value_names("", value.channels, n);
   write_image(paths_.layer_exr(layer.name, frame), value, exr);
+}
+
+void FileStore::write_qa_map(const std::string& kind, const pipeline::Layer& layer, int frame,
+                             ImageView<const float> map) {
+  CHECK(access_ != StoreAccess::kInspect);
+  io::write_qa_map(paths_.folder, kind, layer.name, frame, map);
 }
 
 void FileStore::write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,

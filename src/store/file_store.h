@@ -86,6 +86,10 @@ class FileStore : public pipeline::Store {
   void write_field(const pipeline::Layer& layer, int frame, ImageView<const int32_t> nnf,
                    uint64_t digest) override;
   void remove_field(const pipeline::Layer& layer, int frame) override;
+  // OUTPUT/qa/KIND/LAYER/frame_NNNN.png (store/qa_maps.h): the maps of the last run or qa
+  // command that made them.
+  void write_qa_map(const std::string& kind, const pipeline::Layer& layer, int frame,
+                    ImageView<const float> map) override;
   Image<int32_t> read_field(const pipeline::Layer& layer, int frame,
                             uint64_t digest) const override;
   bool has_frame(int frame) const override;

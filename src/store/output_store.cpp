@@ -213,6 +213,12 @@ std::string file_digest(const std::string& path) {
   return text;
 }
 
+std::string bytes_digest(std::string_view bytes) {
+  Digest d;
+  d.add(bytes.data(), bytes.size());
+  return d.text();
+}
+
 std::optional<std::string> read_input_file(const std::string& path, std::size_t cap) {
   struct stat st {};
   const Fd f{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
@@ -221,10 +227,9 @@ std::optional<std::string> read_input_file(const std::string& path, std::size_t 
   std::optional<std::string> bytes = read_all(f.fd, cap);
   // A file that changed size while it was read is read again the ordinary way.
   if (!bytes || bytes->size() != std::size_t(st.st_size)) return std::nullopt;
-  Digest d;
-  d.add(bytes->data(), bytes->size());
+  const std::string digest = bytes_digest(*bytes);
   const std::lock_guard lock(digests_mutex());
-  digests()[id_of(path, st)] = d.text();
+  digests()[id_of(path, st)] = digest;
   return bytes;
 }
 

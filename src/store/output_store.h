@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/temp_file.h"
@@ -45,6 +46,8 @@ std::string manifest_difference(const Manifest& have, const Manifest& want);
 // identity (device, inode, size, modification time), so the manifests of a shot's layers, which
 // all name its paintings, cost one read of each.
 std::string file_digest(const std::string& path);
+// The digest file_digest gives a file holding `bytes`.
+std::string bytes_digest(std::string_view bytes);
 
 // The bytes of the regular file `path` (at most `cap`) in one open, their digest remembered for
 // file_digest: an input read to be decoded is not read again for the manifests. nullopt when it

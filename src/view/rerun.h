@@ -18,8 +18,8 @@
 namespace emaki::view {
 
 struct RerunOptions {
-  std::chrono::milliseconds poll{100};    // how often the files are looked at
-  std::chrono::milliseconds settle{250};  // quiet time after the last save before a run
+  std::chrono::milliseconds poll{50};     // how often the files are looked at
+  std::chrono::milliseconds settle{150};  // quiet time after the last save before a run
 };
 
 class Rerun {
