@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "farm/farm_state.h"
 #include "shot/api.h"
+#include "tests/file_bytes.h"
 #include "tests/small_painting.h"
 
 namespace emaki::farm {
@@ -25,13 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kData = EMAKI_TEST_DATA;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 void write_file(const fs::path& p, const std::string& text, bool executable = false) {
   std::ofstream(p, std::ios::binary) << text;
@@ -77,7 +71,9 @@ class SlurmTest : public ::testing::Test {
     fs::remove_all(dir_);
   }
   std::string painting() const { return (dir_ / "painting.png").string(); }
-  std::string logged(const std::string& tool) const { return slurp(dir_ / "log" / tool); }
+  std::string logged(const std::string& tool) const {
+    return test::file_bytes(dir_ / "log" / tool);
+  }
 
   // A two-frame shot written to FILE, its outputs in `folder` (TOML basic-string text, so
   // escapes such as \n are the file's own).
@@ -149,7 +145,7 @@ TEST_F(SlurmTest, HostileButRepresentableNamesRunNoCommand) {
     if (t.done) continue;
     EXPECT_EQ(read_state_file(farm + "/status/" + t.id + ".exit", 100), "0\n") << t.id;
     // The task ran with its arguments whole.
-    const std::string log = slurp(farm + "/logs/" + t.id + ".log");
+    const std::string log = test::file_bytes(farm + "/logs/" + t.id + ".log");
     EXPECT_NE(log.find("[" + p.shots[0].path + "]"), std::string::npos) << log;
   }
   // The folder's path only in sbatch's arguments, its % doubled in the --output pattern.
@@ -210,11 +206,11 @@ TEST_F(SlurmTest, TheJobScriptDoesNotFollowPlantedSymlinks) {
   }
   const std::string run = "cd '" + farm + "' && SLURM_ARRAY_TASK_ID=0 sh '" + script.string() + "'";
   EXPECT_EQ(std::system(run.c_str()), 0);
-  for (const fs::path& v : victims) EXPECT_EQ(slurp(v), "precious\n") << v;
+  for (const fs::path& v : victims) EXPECT_EQ(test::file_bytes(v), "precious\n") << v;
   for (const char* ext : {".start", ".end", ".exit"})
     EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(farm + "/status/" + t.id + ext))) << ext;
-  EXPECT_EQ(slurp(farm + "/status/" + t.id + ".exit"), "0\n");
-  EXPECT_NE(slurp(farm + "/logs/" + t.id + ".log").find("[prepare]"), std::string::npos);
+  EXPECT_EQ(test::file_bytes(farm + "/status/" + t.id + ".exit"), "0\n");
+  EXPECT_NE(test::file_bytes(farm + "/logs/" + t.id + ".log").find("[prepare]"), std::string::npos);
 }
 
 // A jobs.tsv copied from another shot (or stale) names jobs that are not this shot's: squeue is

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "io/image_io.h"
 #include "tests/error_of.h"
+#include "tests/file_bytes.h"
 #include "tests/small_painting.h"
 
 namespace emaki::shot {
@@ -143,11 +144,6 @@ TEST_F(ShotApi, RequestErrorsNameNeutralFields) {
   EXPECT_EQ(error_of([&] { flicker(shot, "base", Request{}); }).subject(), "layers.base");
 }
 
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // The QA maps (store/qa_maps.h): one PNG per measured frame under qa/KIND/LAYER/, the same bytes
 // every time, not all black; a measure refused writes none.
 TEST_F(ShotApi, QaMapsAreWrittenPerFrameTheSameEachTime) {
@@ -175,17 +171,17 @@ TEST_F(ShotApi, QaMapsAreWrittenPerFrameTheSameEachTime) {
   for (int y = 0; y < error.height(); ++y)
     for (int x = 0; x < error.width(); ++x) sum += error(x, y, 0) + error(x, y, 2);
   EXPECT_GT(sum, 0.0);
-  const std::string flicker_map = bytes_of(qa / "flicker/base/frame_0001.png");
-  const std::string ghost_map = bytes_of(qa / "ghost/base/frame_0002.png");
-  const std::string error_map = bytes_of(qa / "error/ink/frame_0001.png");
+  const std::string flicker_map = test::file_bytes(qa / "flicker/base/frame_0001.png");
+  const std::string ghost_map = test::file_bytes(qa / "ghost/base/frame_0002.png");
+  const std::string error_map = test::file_bytes(qa / "error/ink/frame_0001.png");
   flicker(shot, "base", maps);
   ghost(shot, "base", maps);
   r.force = true;
   r.threads = 1;  // the maps do not depend on the thread count either
   run(shot, r);
-  EXPECT_TRUE(bytes_of(qa / "flicker/base/frame_0001.png") == flicker_map);
-  EXPECT_TRUE(bytes_of(qa / "ghost/base/frame_0002.png") == ghost_map);
-  EXPECT_TRUE(bytes_of(qa / "error/ink/frame_0001.png") == error_map);
+  EXPECT_TRUE(test::file_bytes(qa / "flicker/base/frame_0001.png") == flicker_map);
+  EXPECT_TRUE(test::file_bytes(qa / "ghost/base/frame_0002.png") == ghost_map);
+  EXPECT_TRUE(test::file_bytes(qa / "error/ink/frame_0001.png") == error_map);
 }
 
 }  // namespace

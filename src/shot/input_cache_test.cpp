@@ -14,6 +14,7 @@
 #include "render/passes.h"
 #include "shot/api.h"
 #include "shot/inputs.h"
+#include "tests/file_bytes.h"
 #include "tests/small_painting.h"
 #include "tests/test_dir.h"
 
@@ -22,11 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kData = EMAKI_TEST_DATA;
-
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 class InputCacheRun : public ::testing::Test {
  protected:
@@ -64,7 +60,7 @@ class InputCacheRun : public ::testing::Test {
          {"layers/base/base_0001.exr", "layers/ink/ink_0001.exr", "layers/base/base_0001.png",
           "composite/frame_0001.png", "layered/frame_0001.exr"}) {
       SCOPED_TRACE(f);
-      const std::string x = bytes_of(dir_ / a / f), y = bytes_of(dir_ / b / f);
+      const std::string x = test::file_bytes(dir_ / a / f), y = test::file_bytes(dir_ / b / f);
       ASSERT_FALSE(x.empty());
       EXPECT_TRUE(x == y);
     }
@@ -123,7 +119,8 @@ TEST_F(InputCacheRun, ARunAfterASaveOfThePassFileEqualsAFreshRun) {
   run(keyframe("fresh"), frame(1, false));
   for (const char* f : {"layers/base/base_0001.exr", "composite/frame_0001.png"}) {
     SCOPED_TRACE(f);
-    const std::string x = bytes_of(dir_ / "kept" / f), y = bytes_of(dir_ / "fresh" / f);
+    const std::string x = test::file_bytes(dir_ / "kept" / f),
+                      y = test::file_bytes(dir_ / "fresh" / f);
     ASSERT_FALSE(x.empty());
     EXPECT_TRUE(x == y);
   }

@@ -18,6 +18,7 @@
 #include "shot/api.h"
 #include "synth/synthesizer.h"
 #include "synth/test_images.h"
+#include "tests/file_bytes.h"
 #include "tests/small_painting.h"
 
 namespace emaki::shot {
@@ -25,11 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kData = EMAKI_TEST_DATA;
-
-std::string file_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 class ShotIsolation : public ::testing::Test {
  protected:
@@ -57,7 +53,7 @@ class ShotIsolation : public ::testing::Test {
     return open_text(text, (dir_ / (name + ".toml")).string());
   }
   std::string composite_bytes(const std::string& name) const {
-    return file_bytes(dir_ / name / "composite" / "frame_0002.png");
+    return test::file_bytes(dir_ / name / "composite" / "frame_0002.png");
   }
 
   fs::path dir_;
