@@ -15,7 +15,10 @@ Rerun::~Rerun() {
 }
 
 void Rerun::start() {
-  m_watcher = std::thread([this] { watch(); });
+  // The stamps the first save is compared against are taken here, before the first run starts:
+  // taken on the watcher's thread, a save made once the run has started could become the
+  // reference itself and never be seen.
+  m_watcher = std::thread([this, seen = stamps()]() mutable { watch(std::move(seen)); });
   m_runner = std::thread([this] { run_loop(); });
 }
 
@@ -43,8 +46,7 @@ std::string Rerun::stamps() const {
   return s;
 }
 
-void Rerun::watch() {
-  std::string seen = stamps();
+void Rerun::watch(std::string seen) {
   std::unique_lock lock(m_mutex);
   while (!m_stopping) {
     m_wake.wait_for(lock, m_options.poll, [&] { return m_stopping; });

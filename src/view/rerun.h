@@ -42,7 +42,7 @@ class Rerun {
 
  private:
   std::string stamps() const;
-  void watch();
+  void watch(std::string seen);
   void run_loop();
 
   std::vector<std::filesystem::path> m_files;
