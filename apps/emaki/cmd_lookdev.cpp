@@ -74,6 +74,10 @@ pipeline::Shot preview_shot(const std::string& path, double scale, const std::st
   s.source.render.width = s.source.width;
   s.source.render.height = s.source.height;
   s.source.render.outline_width = float(s.source.render.outline_width * scale);
+  // The paintings shrink with the frame, so that the preview's strokes keep their size against
+  // it (a full-size painting would paint a half-size frame with strokes twice as large).
+  for (pipeline::Exemplar& e : s.exemplars)
+    if (e.kind == pipeline::ExemplarKind::kMatcap) e.scale = scale;
   if (!temporal)
     for (pipeline::Layer& l : s.layers) l.temporal.enabled = false;
   s.outputs.folder = out;

@@ -84,6 +84,9 @@ struct Exemplar {
   // The painting's colour space (a name or role of the shot's config); it is converted to the
   // config's color_picking space, the painter's values the synthesis sees.
   std::string colorspace = "color_picking";
+  // The painting resampled to this share of its size before use (not in the shot file):
+  // emaki lookdev's --scale, so that a preview's strokes keep their size against the frame.
+  double scale = 1.0;
 };
 
 struct GuideSpec {

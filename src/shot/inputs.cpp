@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <mutex>
 #include <optional>
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/resample.h"
 #include "core/shot_keys.h"
 #include "io/gltf_loader.h"
 #include "io/image_io.h"
@@ -283,6 +285,10 @@ std::map<std::string, pipeline::ExemplarImages> load_exemplars(const Shot& shot,
     pipeline::ExemplarImages im;
     im.painting = rgb_of(key + ".painting", e.painting, cache);
     shot.colour.get().convert(im.painting.view(), e.colorspace, "color_picking");
+    if (e.scale != 1.0)
+      im.painting = resample_area(im.painting.cview(),
+                                  std::max(1, int(std::lround(im.painting.width() * e.scale))),
+                                  std::max(1, int(std::lround(im.painting.height() * e.scale))));
     const int w = im.painting.width(), h = im.painting.height();
     const bool matcap = e.kind == pipeline::ExemplarKind::kMatcap;
     // With a cache, the guides its layers cut out of the passes, under what the passes are.

@@ -127,6 +127,7 @@ void add_exemplar(Lines& l, const pipeline::Exemplar& e) {
   l.add(p + "painting.digest", file_digest(e.painting));
   // Only when not the default, so that outputs made before the key existed stay current.
   if (e.colorspace != pipeline::Exemplar{}.colorspace) l.add(p + "colorspace", e.colorspace);
+  if (e.scale != 1.0) l.add(p + "scale", e.scale);
   if (e.kind == pipeline::ExemplarKind::kMatcap) {
     add_reference(l, p, e);
   } else {
