@@ -77,5 +77,18 @@ for l in base shadow outline; do
 done
 ! cmp -s "$work/temporal/layers/base/base_0003.exr" "$work/by_frame/layers/base/base_0003.exr" ||
   { echo "FAIL: --temporal's frame 3 did not use the chain"; exit 1; }
+# --scale 0.5 with a painted weight map of the shot's size: the map is resampled to the preview.
+cp "$work/fresh/composite/frame_0000.png" "$work/map.png"
+sed -e 's#^guides = { normal = 1.0, diffuse = 1.5 }#guides = { normal = 1.0, diffuse = { weight = 1.5, map = "map.png" } }#' \
+  "$work/shot.toml" > "$work/mapped.toml"
+grep -q 'map = "map.png"' "$work/mapped.toml" || { echo "FAIL: the base layer's guides line moved"; exit 1; }
+port=$((port + 1))
+"$emaki" lookdev "$work/mapped.toml" --frames 0 --scale 0.5 --port "$port" --out "$work/half" \
+  > "$work/url" 2> "$work/log" &
+pid=$!
+wait_for '"generation":1,'
+kill $pid && wait $pid || { echo "FAIL: lookdev --scale 0.5 did not stop cleanly"; exit 1; }
+[ -f "$work/half/layers/base/base_0000.exr" ] ||
+  { echo "FAIL: --scale 0.5 with a weight map made no base frame"; cat "$work/log"; exit 1; }
 trap - EXIT
 echo "ok"

@@ -69,6 +69,8 @@ pipeline::Shot preview_shot(const std::string& path, double scale, const std::st
   pipeline::Shot s = shot::open(path);
   if (scale != 1.0 && s.source.kind != pipeline::SourceKind::kScene)
     throw Error("--scale", "a shot of studio passes is previewed at their own size (--scale 1)");
+  s.source.maps_width = s.source.width;  // painted weight maps are resampled to the preview
+  s.source.maps_height = s.source.height;
   s.source.width = std::max(8, int(std::lround(s.source.width * scale)));
   s.source.height = std::max(8, int(std::lround(s.source.height * scale)));
   s.source.render.width = s.source.width;

@@ -67,6 +67,9 @@ struct Source {
   // The colour space of the colour passes (albedo), converted to the config's scene_linear on
   // reading; data passes (normals, positions, ids, motion) are never converted.
   std::string passes_colorspace = "scene_linear";
+  // The size the painted weight maps are (0: the shot's). Not in the shot file: emaki lookdev
+  // previews a shot at another size, and its maps are resampled to it.
+  int maps_width = 0, maps_height = 0;
 };
 
 enum class ExemplarKind {

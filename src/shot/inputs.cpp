@@ -335,10 +335,15 @@ pipeline::WeightMapImages load_weight_maps(const Shot& shot, InputCache* cache) 
           decoded(cache, "image float", g.map_image, [&](const std::optional<std::string>& bytes) {
             return read_input_image(g.map_image, bytes);
           });
-      if (img.width() != shot.source.width || img.height() != shot.source.height)
+      const int w = shot.source.maps_width > 0 ? shot.source.maps_width : shot.source.width;
+      const int h = shot.source.maps_height > 0 ? shot.source.maps_height : shot.source.height;
+      if (img.width() != w || img.height() != h)
         throw Error(key, fmt::format("'{}' is {}x{}, the shot is {}x{}", g.map_image, img.width(),
-                                     img.height(), shot.source.width, shot.source.height));
-      out.emplace(g.map_image, pipeline::extract(img.cview(), 0, 1));
+                                     img.height(), w, h));
+      Image<float> map = pipeline::extract(img.cview(), 0, 1);
+      if (w != shot.source.width || h != shot.source.height)
+        map = resample_area(map.cview(), shot.source.width, shot.source.height);
+      out.emplace(g.map_image, std::move(map));
     }
   return out;
 }
