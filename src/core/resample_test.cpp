@@ -32,7 +32,8 @@ TEST(ResampleArea, HalvingAveragesEachTwoByTwoBlock) {
     for (int x = 0; x < 4; ++x)
       for (int c = 0; c < 2; ++c) {
         const float want = (in(2 * x, 2 * y, c) + in(2 * x + 1, 2 * y, c) +
-                            in(2 * x, 2 * y + 1, c) + in(2 * x + 1, 2 * y + 1, c)) / 4;
+                            in(2 * x, 2 * y + 1, c) + in(2 * x + 1, 2 * y + 1, c)) /
+                           4;
         EXPECT_NEAR(out(x, y, c), want, 1e-6f);
       }
 }
