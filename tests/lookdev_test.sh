@@ -46,30 +46,24 @@ echo "burst of 10 saves: $runs runs; generation $(status)"
 [ "$before" != "$after" ] || { echo "FAIL: the preview frame was not made again"; exit 1; }
 [ $runs -ge 1 ] && [ $runs -le 2 ] || { echo "FAIL: $runs runs for one burst"; cat "$work/log"; exit 1; }
 kill $pid && wait $pid || { echo "FAIL: lookdev did not stop cleanly on SIGTERM"; exit 1; }
+one_run() {  # SHOT, OUT_DIR, then lookdev's own options
+  shot=$1 out=$2; shift 2
+  port=$((port + 1))
+  "$emaki" lookdev "$shot" --port "$port" --out "$out" "$@" > "$work/url" 2> "$work/log" &
+  pid=$!
+  wait_for '"generation":1,'
+  kill $pid && wait $pid || { echo "FAIL: lookdev $* did not stop cleanly"; exit 1; }
+}
 # The frame made after the saves, from what the runs kept in memory, is the frame a fresh
 # lookdev of the saved painting makes.
-port=$((port + 1))
-"$emaki" lookdev "$work/shot.toml" --frames 0 --scale 1 --port "$port" --out "$work/fresh" \
-  > "$work/url" 2> "$work/log" &
-pid=$!
-wait_for '"generation":1,'
-kill $pid && wait $pid || { echo "FAIL: the fresh lookdev did not stop cleanly"; exit 1; }
+one_run "$work/shot.toml" "$work/fresh" --frames 0 --scale 1
 for f in composite/frame_0000.png layers/base/base_0000.exr layers/outline/outline_0000.exr; do
   cmp -s "$work/out.lookdev/$f" "$work/fresh/$f" || { echo "FAIL: $f differs from a fresh run"; exit 1; }
 done
 # --temporal: frame 3 from frame 2 made as a chain's first frame, nothing before it; frame 2
 # is frame by frame's, frame 3 is not.
-one_run() {  # OUT_DIR, then lookdev's own options
-  out=$1; shift
-  port=$((port + 1))
-  "$emaki" lookdev "$work/shot.toml" --scale 1 --port "$port" --out "$out" "$@" \
-    > "$work/url" 2> "$work/log" &
-  pid=$!
-  wait_for '"generation":1,'
-  kill $pid && wait $pid || { echo "FAIL: lookdev $* did not stop cleanly"; exit 1; }
-}
-one_run "$work/temporal" --frames 3 --temporal
-one_run "$work/by_frame" --frames 2,3
+one_run "$work/shot.toml" "$work/temporal" --frames 3 --temporal --scale 1
+one_run "$work/shot.toml" "$work/by_frame" --frames 2,3 --scale 1
 [ ! -e "$work/temporal/layers/base/base_0001.exr" ] || { echo "FAIL: --temporal made frame 1"; exit 1; }
 for l in base shadow outline; do
   cmp -s "$work/temporal/layers/$l/${l}_0002.exr" "$work/by_frame/layers/$l/${l}_0002.exr" ||
@@ -82,12 +76,7 @@ cp "$work/fresh/composite/frame_0000.png" "$work/map.png"
 sed -e 's#^guides = { normal = 1.0, diffuse = 1.5 }#guides = { normal = 1.0, diffuse = { weight = 1.5, map = "map.png" } }#' \
   "$work/shot.toml" > "$work/mapped.toml"
 grep -q 'map = "map.png"' "$work/mapped.toml" || { echo "FAIL: the base layer's guides line moved"; exit 1; }
-port=$((port + 1))
-"$emaki" lookdev "$work/mapped.toml" --frames 0 --scale 0.5 --port "$port" --out "$work/half" \
-  > "$work/url" 2> "$work/log" &
-pid=$!
-wait_for '"generation":1,'
-kill $pid && wait $pid || { echo "FAIL: lookdev --scale 0.5 did not stop cleanly"; exit 1; }
+one_run "$work/mapped.toml" "$work/half" --frames 0 --scale 0.5
 [ -f "$work/half/layers/base/base_0000.exr" ] ||
   { echo "FAIL: --scale 0.5 with a weight map made no base frame"; cat "$work/log"; exit 1; }
 trap - EXIT
