@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -230,10 +232,57 @@ Image<float> paper_image(const Paper& paper, int width, int height) {
   return out;
 }
 
+namespace {
+
+// `to_working` on the pixels of `rgba` with alpha > 0: gathered row by row (in order) into an
+// RGB image `rgba`'s width wide, converted, put back. Each pixel's conversion is its own, so
+// this gives what converting all of them gives where it matters.
+void to_working_where_covered(ImageView<float> rgba, const ToWorkingSpace& to_working) {
+  const int width = rgba.width, height = rgba.height;
+  std::vector<int64_t> first(std::size_t(height) + 1, 0);
+  parallel_rows(height, 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      int64_t n = 0;
+      for (int x = 0; x < width; ++x) n += rgba.at(x, y)[3] > 0.0f ? 1 : 0;
+      first[std::size_t(y) + 1] = n;
+    }
+  });
+  for (int y = 0; y < height; ++y) first[std::size_t(y) + 1] += first[std::size_t(y)];
+  const int64_t covered = first[std::size_t(height)];
+  if (covered == 0) return;
+  Image<float> packed(width, int((covered + width - 1) / width), 3);
+  // Visits the covered pixels of rows y0..y1 with their packed pixel.
+  const auto each = [&](int y0, int y1, const auto& fn) {
+    for (int y = y0; y < y1; ++y) {
+      int64_t i = first[std::size_t(y)];
+      for (int x = 0; x < width; ++x) {
+        float* p = rgba.at(x, y);
+        if (!(p[3] > 0.0f)) continue;
+        fn(p, packed.at(int(i % width), int(i / width)));
+        ++i;
+      }
+    }
+  };
+  parallel_rows(height, 16, [&](int y0, int y1) {
+    each(y0, y1, [](const float* p, float* q) { std::copy_n(p, 3, q); });
+  });
+  to_working(packed.view());
+  parallel_rows(height, 16, [&](int y0, int y1) {
+    each(y0, y1, [](float* p, const float* q) { std::copy_n(q, 3, p); });
+  });
+}
+
+}  // namespace
+
 Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper, int width,
                        int height, const ToWorkingSpace& to_working) {
-  Image<float> base = paper_image(paper, width, height);
-  if (to_working) to_working(base.view());
+  Image<float> made;
+  ImageView<const float> base = paper.made;
+  if (base.empty() || base.width != width || base.height != height || base.channels < 3) {
+    made = paper_image(paper, width, height);
+    if (to_working) to_working(made.view());
+    base = made.cview();
+  }
   Image<float> out(width, height, 4);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -242,7 +291,7 @@ Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper
     }
   for (const LayerInput& layer : layers) {
     Image<float> rgba = color_layer(layer, width, height);
-    if (to_working) to_working(rgba.view());
+    if (to_working) to_working_where_covered(rgba.view(), to_working);
     const BlendMode mode = layer.look.blend;
     parallel_rows(height, 16, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)
