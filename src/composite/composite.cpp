@@ -234,41 +234,28 @@ Image<float> paper_image(const Paper& paper, int width, int height) {
 
 namespace {
 
-// `to_working` on the pixels of `rgba` with alpha > 0: gathered row by row (in order) into an
-// RGB image `rgba`'s width wide, converted, put back. Each pixel's conversion is its own, so
-// this gives what converting all of them gives where it matters.
+// `to_working` on the pixels of `rgba` with alpha > 0: a row band's are gathered into one row
+// of RGB (a scratch buffer per thread), converted, put back. Each pixel's conversion is its
+// own, so this gives what converting all of them gives where it matters.
 void to_working_where_covered(ImageView<float> rgba, const ToWorkingSpace& to_working) {
-  const int width = rgba.width, height = rgba.height;
-  std::vector<int64_t> first(std::size_t(height) + 1, 0);
-  parallel_rows(height, 16, [&](int y0, int y1) {
+  parallel_rows(rgba.height, 16, [&](int y0, int y1) {
+    thread_local std::vector<float*> where;
+    thread_local std::vector<float> rgb;
+    where.clear();
+    rgb.clear();
     for (int y = y0; y < y1; ++y) {
-      int64_t n = 0;
-      for (int x = 0; x < width; ++x) n += rgba.at(x, y)[3] > 0.0f ? 1 : 0;
-      first[std::size_t(y) + 1] = n;
+      float* p = rgba.row(y);
+      for (int x = 0; x < rgba.width; ++x, p += rgba.channels)
+        if (p[3] > 0.0f) {
+          where.push_back(p);
+          rgb.insert(rgb.end(), p, p + 3);
+        }
     }
-  });
-  for (int y = 0; y < height; ++y) first[std::size_t(y) + 1] += first[std::size_t(y)];
-  const int64_t covered = first[std::size_t(height)];
-  if (covered == 0) return;
-  Image<float> packed(width, int((covered + width - 1) / width), 3);
-  // Visits the covered pixels of rows y0..y1 with their packed pixel.
-  const auto each = [&](int y0, int y1, const auto& fn) {
-    for (int y = y0; y < y1; ++y) {
-      int64_t i = first[std::size_t(y)];
-      for (int x = 0; x < width; ++x) {
-        float* p = rgba.at(x, y);
-        if (!(p[3] > 0.0f)) continue;
-        fn(p, packed.at(int(i % width), int(i / width)));
-        ++i;
-      }
-    }
-  };
-  parallel_rows(height, 16, [&](int y0, int y1) {
-    each(y0, y1, [](const float* p, float* q) { std::copy_n(p, 3, q); });
-  });
-  to_working(packed.view());
-  parallel_rows(height, 16, [&](int y0, int y1) {
-    each(y0, y1, [](float* p, const float* q) { std::copy_n(q, 3, p); });
+    if (where.empty()) return;
+    const int n = int(where.size());
+    to_working(ImageView<float>{rgb.data(), n, 1, 3, std::ptrdiff_t(n) * 3});
+    for (int i = 0; i < n; ++i)
+      std::copy_n(rgb.data() + std::ptrdiff_t(i) * 3, 3, where[std::size_t(i)]);
   });
 }
 

@@ -117,7 +117,7 @@ using ToWorkingSpace = std::function<void(ImageView<float>)>;
 // With `to_working`, the paper and each coloured layer go through it before they are blended,
 // and the blending is done on its values (no clamp to [0, 1]). A layer's pixels it does not
 // cover (alpha 0) leave what is below them as it is, so only the covered ones are converted
-// (gathered into one RGB image for the call).
+// (a row band's gathered into one row of RGB for each call).
 // Throws emaki::Error naming the layer when its sizes do not match or an input it needs is
 // missing.
 Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper, int width,
