@@ -135,6 +135,23 @@ struct Steps::Step {
 };
 
 Steps::Steps(const OCIO::ConstConfigRcPtr& config, const OCIO::ConstProcessorRcPtr& processor) {
+  // A processor whose values can change after it is made (dynamic properties) keeps no table;
+  // nor does one that cannot be cut (an op OpenColorIO cannot turn back into a transform).
+  // With no table (or none allowed), the processor as it is, one step.
+  if (!processor->isDynamic()) {
+    try {
+      if (cut(config, processor)) return;
+    } catch (const OCIO::Exception&) {
+      // the whole processor, below
+    }
+  }
+  steps_.clear();
+  auto step = std::make_unique<Step>();
+  step->cpu = processor->getDefaultCPUProcessor();
+  steps_.push_back(std::move(step));
+}
+
+bool Steps::cut(const OCIO::ConstConfigRcPtr& config, const OCIO::ConstProcessorRcPtr& processor) {
   const OCIO::GroupTransformRcPtr all =
       processor->getOptimizedProcessor(OCIO::OPTIMIZATION_DEFAULT)->createGroupTransform();
   const int n = all->getNumTransforms();
@@ -171,15 +188,9 @@ Steps::Steps(const OCIO::ConstConfigRcPtr& config, const OCIO::ConstProcessorRcP
     }
     i = std::max(j, i + 1);
   }
-  if (pending_first == 0) {
-    // No table: the processor as it is, one step.
-    steps_.clear();
-    auto step = std::make_unique<Step>();
-    step->cpu = processor->getDefaultCPUProcessor();
-    steps_.push_back(std::move(step));
-    return;
-  }
+  if (pending_first == 0) return false;  // no table
   flush(n);
+  return true;
 }
 
 Steps::~Steps() = default;

@@ -5,9 +5,11 @@
 // crosstalk holding at least one curve becomes a table per channel, every other run stays an
 // OpenColorIO processor. A table holds the run's exact values (OpenColorIO's) at 2^10 points
 // per octave of |x| in [2^-32, 2^32), both signs and zero; between points it interpolates
-// linearly in x, within ~1e-6 of OpenColorIO's own result (the curves are smooth between their
-// knots). Values outside that range (tiny, huge, inf, NaN) go through OpenColorIO as they are.
-// Each pixel's result is its own, whatever its neighbours or the band it is in.
+// linearly in x (the curves are smooth between their knots). Values outside that range (tiny,
+// huge, inf, NaN) go through OpenColorIO as they are. Against OpenColorIO's whole processor,
+// the largest difference over colour_test's sweep is 6.6e-7 for the sRGB curve and 3.5e-6 for
+// the Filmic view (there mostly OpenColorIO's own: 4x the points leave it as it is); the test
+// holds it within 1e-5. Each pixel's result is its own, whatever its neighbours or its band.
 #pragma once
 
 #include <OpenColorIO/OpenColorIO.h>
@@ -38,6 +40,10 @@ class Steps {
   struct Step;
 
  private:
+  // Cuts the processor's optimized transforms into steps; false when none is a table.
+  bool cut(const OCIO_NAMESPACE::ConstConfigRcPtr& config,
+           const OCIO_NAMESPACE::ConstProcessorRcPtr& processor);
+
   std::vector<std::unique_ptr<Step>> steps_;
 };
 
