@@ -370,12 +370,14 @@ Image<float> sweep() {
 
 // Steps (tables for the curves) against OpenColorIO's own processor, value by value: within
 // 1e-5 (relative above 1; a tenth of what the tests against ocioconvert allow), inf and NaN where
-// it gives them, for pixels that are finite; and the tables are used.
+// it gives them, for pixels that are finite; and `tables` tables are used (-1: any number).
 void expect_steps_match(const OCIO::ConstConfigRcPtr& config,
                         const OCIO::ConstProcessorRcPtr& processor, int tables,
                         const std::string& what) {
   const Steps steps(config, processor);
-  EXPECT_EQ(steps.table_steps(), tables) << what;
+  if (tables >= 0) {
+    EXPECT_EQ(steps.table_steps(), tables) << what;
+  }
   Image<float> got = sweep(), want = sweep();
   steps.apply(got.view());
   const ImageView<float> w = want.view();
@@ -450,10 +452,11 @@ TEST_F(ColourTest, StepsMatchTheProcessor) {
                      "sRGB texture -> Filmic");
   if (!fs::exists(kBlenderConfig)) GTEST_SKIP() << kBlenderConfig << " is not installed";
   const auto blender = OCIO::Config::CreateFromFile(kBlenderConfig.c_str());
-  // Its Standard view is a 1D LUT (no table); Filmic, a log curve before its LUTs.
-  for (const auto& [view, tables] : {std::pair{"Standard", 0}, std::pair{"Filmic", 1}}) {
+  // Blender 3.4's Standard view is a 1D LUT (no table), its Filmic a log curve before its LUTs
+  // (one table); another Blender's config may cut otherwise.
+  for (const char* view : {"Standard", "Filmic"}) {
     const auto p = view_processor(blender, "Linear", blender->getDefaultDisplay(), view);
-    expect_steps_match(blender, p, tables, std::string("Blender Linear -> ") + view);
+    expect_steps_match(blender, p, -1, std::string("Blender Linear -> ") + view);
   }
 }
 
