@@ -11,8 +11,8 @@
 #include <mutex>
 #include <sstream>
 
+#include "colour/steps.h"
 #include "core/error.h"
-#include "core/parallel.h"
 
 namespace emaki::colour {
 
@@ -28,6 +28,8 @@ struct Config::Impl {
   // there takes a lock and a digest of the config per call.
   mutable std::mutex mutex;
   mutable std::map<std::string, OCIO::ConstCPUProcessorRcPtr> processors;
+  // The conversions of images (convert, to_display), run as steps (colour/steps.h).
+  mutable std::map<std::string, std::shared_ptr<const Steps>> conversions;
 
   OCIO::ConstCPUProcessorRcPtr processor(const std::string& cache_key,
                                          const std::function<OCIO::ConstProcessorRcPtr()>& make,
@@ -37,6 +39,19 @@ struct Config::Impl {
     if (it != processors.end()) return it->second;
     try {
       return processors[cache_key] = make()->getDefaultCPUProcessor();
+    } catch (const OCIO::Exception& e) {
+      throw Error(origin, fmt::format("cannot convert {}: {}", what, e.what()));
+    }
+  }
+
+  std::shared_ptr<const Steps> conversion(const std::string& cache_key,
+                                          const std::function<OCIO::ConstProcessorRcPtr()>& make,
+                                          const std::string& what) const {
+    const std::lock_guard<std::mutex> lock(mutex);
+    auto it = conversions.find(cache_key);
+    if (it != conversions.end()) return it->second;
+    try {
+      return conversions[cache_key] = std::make_shared<const Steps>(config, make());
     } catch (const OCIO::Exception& e) {
       throw Error(origin, fmt::format("cannot convert {}: {}", what, e.what()));
     }
@@ -70,19 +85,6 @@ std::string quoted_list(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "'" : ", '") + n + "'";
   return out;
-}
-
-// Applies `cpu` to the first three channels of every pixel, in row bands: each pixel's result
-// is its own, so the band split (the thread count) does not change it.
-void apply(const OCIO::ConstCPUProcessorRcPtr& cpu, ImageView<float> image) {
-  if (image.empty()) return;
-  const std::ptrdiff_t pixel = std::ptrdiff_t(image.channels) * std::ptrdiff_t(sizeof(float));
-  const std::ptrdiff_t row = image.stride * std::ptrdiff_t(sizeof(float));
-  parallel_rows(image.height, 16, [&](int y0, int y1) {
-    OCIO::PackedImageDesc desc(image.row(y0), image.width, y1 - y0, OCIO::CHANNEL_ORDERING_RGB,
-                               OCIO::BIT_DEPTH_F32, sizeof(float), pixel, row);
-    cpu->apply(desc);
-  });
 }
 
 }  // namespace
@@ -232,17 +234,18 @@ bool Config::is_identity(const std::string& src, const std::string& dst) const {
 
 void Config::convert(ImageView<float> image, const std::string& src, const std::string& dst) const {
   if (is_identity(src, dst)) return;
-  const auto cpu = impl_->processor(
-      src + '\n' + dst, [&] { return impl_->config->getProcessor(src.c_str(), dst.c_str()); },
-      fmt::format("'{}' to '{}'", src, dst));
-  apply(cpu, image);
+  impl_
+      ->conversion(
+          src + '\n' + dst, [&] { return impl_->config->getProcessor(src.c_str(), dst.c_str()); },
+          fmt::format("'{}' to '{}'", src, dst))
+      ->apply(image);
 }
 
 void Config::to_display(ImageView<float> image, const std::string& src, const std::string& display,
                         const std::string& view) const {
   const std::string space = view_space(display, view);
   if (!space.empty() && is_identity(src, space)) return;
-  const auto cpu = impl_->processor(
+  const auto steps = impl_->conversion(
       src + '\n' + display + '\n' + view + "\nview",
       [&] {
         OCIO::DisplayViewTransformRcPtr t = OCIO::DisplayViewTransform::Create();
@@ -252,7 +255,7 @@ void Config::to_display(ImageView<float> image, const std::string& src, const st
         return impl_->config->getProcessor(t);
       },
       fmt::format("'{}' to display '{}', view '{}'", src, display, view));
-  apply(cpu, image);
+  steps->apply(image);
 }
 
 }  // namespace emaki::colour

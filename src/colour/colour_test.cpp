@@ -2,20 +2,27 @@
 // reference, not against emaki's formulas.
 #include "colour/colour.h"
 
+#include <OpenColorIO/OpenColorIO.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <vector>
 
+#include "colour/steps.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "io/image_io.h"
 
 namespace emaki::colour {
@@ -324,6 +331,133 @@ TEST_F(ColourTest, BlenderConfig) {
   config->to_display(got.view(), "Linear", display, "Filmic");
   expect_near_image(got, ocioconvert(kBlenderConfig, patch(), "Linear", display, "Filmic"), 1e-4f,
                     "Linear -> Filmic");
+}
+
+namespace OCIO = OCIO_NAMESPACE;
+
+// Values a conversion meets and the ones it should survive: +-0, denormals, 2^-40 .. 2^40 at
+// uneven steps (the tables' ends among them), every 8-bit level, 0 .. 1 finely, inf and NaN;
+// then random RGB in [0, 1] and [-1, 64], one row per kind.
+Image<float> sweep() {
+  std::vector<float> v = {0.0f,
+                          -0.0f,
+                          1e-40f,
+                          -1e-40f,
+                          std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN()};
+  for (double e = -40.0; e < 40.0; e += 0.0137) {
+    v.push_back(float(std::exp2(e)));
+    v.push_back(-float(std::exp2(e)));
+  }
+  for (int i = 0; i <= 255; ++i) v.push_back(float(i) / 255.0f);
+  for (int i = 0; i <= 20000; ++i) v.push_back(float(i) / 20000.0f);
+  const int width = int(v.size());
+  Image<float> img(width, 3, 3);
+  uint64_t state = 0x9e3779b97f4a7c15ull;
+  auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return float(state >> 40) / float(1 << 24);
+  };
+  for (int x = 0; x < width; ++x)
+    for (int c = 0; c < 3; ++c) {
+      img(x, 0, c) = v[std::size_t((x + c * 7919) % width)];
+      img(x, 1, c) = next();
+      img(x, 2, c) = next() * 65.0f - 1.0f;
+    }
+  return img;
+}
+
+// Steps (tables for the curves) against OpenColorIO's own processor, value by value: within
+// 1e-5 (relative above 1; a tenth of what the tests against ocioconvert allow), inf and NaN where
+// it gives them, for pixels that are finite; and `tables` tables are used (-1: any number).
+void expect_steps_match(const OCIO::ConstConfigRcPtr& config,
+                        const OCIO::ConstProcessorRcPtr& processor, int tables,
+                        const std::string& what) {
+  const Steps steps(config, processor);
+  if (tables >= 0) {
+    EXPECT_EQ(steps.table_steps(), tables) << what;
+  }
+  Image<float> got = sweep(), want = sweep();
+  steps.apply(got.view());
+  const ImageView<float> w = want.view();
+  OCIO::PackedImageDesc desc(w.row(0), w.width, w.height, OCIO::CHANNEL_ORDERING_RGB,
+                             OCIO::BIT_DEPTH_F32, sizeof(float), 3 * sizeof(float),
+                             w.stride * std::ptrdiff_t(sizeof(float)));
+  processor->getDefaultCPUProcessor()->apply(desc);
+  const Image<float> in = sweep();
+  int bad = 0;
+  float worst = 0.0f;
+  for (int y = 0; y < got.height(); ++y)
+    for (int x = 0; x < got.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        // A pixel with inf or NaN in: what comes out depends on how OpenColorIO joins its ops.
+        if (!(std::isfinite(in(x, y, 0)) && std::isfinite(in(x, y, 1)) &&
+              std::isfinite(in(x, y, 2))))
+          continue;
+        const float g = got(x, y, c), w = want(x, y, c);
+        const bool ok = std::isnan(w)   ? std::isnan(g)
+                        : std::isinf(w) ? g == w
+                                        : std::abs(g - w) <= 1e-5f * std::max(1.0f, std::abs(w));
+        if (std::isfinite(w))
+          worst = std::max(worst, std::abs(g - w) / std::max(1.0f, std::abs(w)));
+        if (!ok && ++bad <= 5)
+          ADD_FAILURE() << what << ": in " << in(x, y, c) << " got " << g << " want " << w;
+      }
+  EXPECT_EQ(bad, 0) << what;
+  std::printf("%s: %d tables, %d processors, largest difference %.3g\n", what.c_str(),
+              steps.table_steps(), steps.processor_steps(), double(worst));
+  // Each pixel's result is its own: one pixel at a time, or on one thread, gives the same bits.
+  Image<float> alone = sweep();
+  for (int x = 0; x < alone.width(); x += 97) {
+    ImageView<float> one = alone.view();
+    one.data = alone.view().row(1) + std::ptrdiff_t(x) * 3;
+    one.width = one.height = 1;
+    steps.apply(one);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(std::bit_cast<uint32_t>(alone(x, 1, c)), std::bit_cast<uint32_t>(got(x, 1, c)))
+          << what << " pixel " << x;
+  }
+  const ScopedThreadCount one_thread(1);
+  Image<float> serial = sweep();
+  steps.apply(serial.view());
+  for (int y = 0; y < got.height(); ++y)
+    for (int x = 0; x < got.width(); ++x)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(std::bit_cast<uint32_t>(serial(x, y, c)), std::bit_cast<uint32_t>(got(x, y, c)));
+}
+
+OCIO::ConstProcessorRcPtr view_processor(const OCIO::ConstConfigRcPtr& config, const char* src,
+                                         const char* display, const char* view) {
+  OCIO::DisplayViewTransformRcPtr t = OCIO::DisplayViewTransform::Create();
+  t->setSrc(src);
+  t->setDisplay(display);
+  t->setView(view);
+  return config->getProcessor(t);
+}
+
+TEST_F(ColourTest, StepsMatchTheProcessor) {
+  const auto config = OCIO::Config::CreateFromFile(kBuiltinFile.c_str());
+  expect_steps_match(config, config->getProcessor(kSrgbTexture, kSceneLinear), 1,
+                     "sRGB texture -> scene-linear");
+  expect_steps_match(config, config->getProcessor(kSceneLinear, kSrgbTexture), 1,
+                     "scene-linear -> sRGB texture");
+  expect_steps_match(config, config->getProcessor(kAcescg, kSceneLinear), 0,
+                     "ACEScg -> scene-linear");
+  expect_steps_match(config, config->getProcessor(kAcescg, kSrgbTexture), 1,
+                     "ACEScg -> sRGB texture");
+  expect_steps_match(config, view_processor(config, kSceneLinear, "sRGB", "Filmic"), 2,
+                     "scene-linear -> Filmic");
+  expect_steps_match(config, view_processor(config, kSrgbTexture, "sRGB", "Filmic"), 3,
+                     "sRGB texture -> Filmic");
+  if (!fs::exists(kBlenderConfig)) GTEST_SKIP() << kBlenderConfig << " is not installed";
+  const auto blender = OCIO::Config::CreateFromFile(kBlenderConfig.c_str());
+  // Blender 3.4's Standard view is a 1D LUT (no table), its Filmic a log curve before its LUTs
+  // (one table); another Blender's config may cut otherwise.
+  for (const char* view : {"Standard", "Filmic"}) {
+    const auto p = view_processor(blender, "Linear", blender->getDefaultDisplay(), view);
+    expect_steps_match(blender, p, -1, std::string("Blender Linear -> ") + view);
+  }
 }
 
 }  // namespace

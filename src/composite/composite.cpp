@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -230,10 +232,44 @@ Image<float> paper_image(const Paper& paper, int width, int height) {
   return out;
 }
 
+namespace {
+
+// `to_working` on the pixels of `rgba` with alpha > 0: a row band's are gathered into one row
+// of RGB (a scratch buffer per thread), converted, put back. Each pixel's conversion is its
+// own, so this gives what converting all of them gives where it matters.
+void to_working_where_covered(ImageView<float> rgba, const ToWorkingSpace& to_working) {
+  parallel_rows(rgba.height, 16, [&](int y0, int y1) {
+    thread_local std::vector<float*> where;
+    thread_local std::vector<float> rgb;
+    where.clear();
+    rgb.clear();
+    for (int y = y0; y < y1; ++y) {
+      float* p = rgba.row(y);
+      for (int x = 0; x < rgba.width; ++x, p += rgba.channels)
+        if (p[3] > 0.0f) {
+          where.push_back(p);
+          rgb.insert(rgb.end(), p, p + 3);
+        }
+    }
+    if (where.empty()) return;
+    const int n = int(where.size());
+    to_working(ImageView<float>{rgb.data(), n, 1, 3, std::ptrdiff_t(n) * 3});
+    for (int i = 0; i < n; ++i)
+      std::copy_n(rgb.data() + std::ptrdiff_t(i) * 3, 3, where[std::size_t(i)]);
+  });
+}
+
+}  // namespace
+
 Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper, int width,
                        int height, const ToWorkingSpace& to_working) {
-  Image<float> base = paper_image(paper, width, height);
-  if (to_working) to_working(base.view());
+  Image<float> made;
+  ImageView<const float> base = paper.made;
+  if (base.empty() || base.width != width || base.height != height || base.channels < 3) {
+    made = paper_image(paper, width, height);
+    if (to_working) to_working(made.view());
+    base = made.cview();
+  }
   Image<float> out(width, height, 4);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -242,7 +278,7 @@ Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper
     }
   for (const LayerInput& layer : layers) {
     Image<float> rgba = color_layer(layer, width, height);
-    if (to_working) to_working(rgba.view());
+    if (to_working) to_working_where_covered(rgba.view(), to_working);
     const BlendMode mode = layer.look.blend;
     parallel_rows(height, 16, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)

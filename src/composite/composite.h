@@ -81,6 +81,10 @@ struct Paper {
   ImageView<const float> texture;  // 1 (grey) or >= 3 channels, sRGB-encoded; empty: no texture
   float scale = 1.0f;              // output pixels per texture pixel, > 0
   Color color{1.0f, 1.0f, 1.0f};   // multiplies the texture; alone when there is no texture
+  // The paper already made at the output's size, in the working space: what paper_image and
+  // composite()'s `to_working` give (a shot's paper is the same on every frame). Empty, or of
+  // another size: made by composite().
+  ImageView<const float> made;
 };
 
 // sRGB transfer functions on one component.
@@ -110,8 +114,10 @@ Image<float> paper_image(const Paper& paper, int width, int height);
 using ToWorkingSpace = std::function<void(ImageView<float>)>;
 
 // Paper, then every layer from first (bottom) to last (top). Returns RGBA with alpha 1.
-// With `to_working`, the paper and each coloured layer (RGB, its alpha kept) go through it
-// before they are blended, and the blending is done on its values (no clamp to [0, 1]).
+// With `to_working`, the paper and each coloured layer go through it before they are blended,
+// and the blending is done on its values (no clamp to [0, 1]). A layer's pixels it does not
+// cover (alpha 0) leave what is below them as it is, so only the covered ones are converted
+// (a row band's gathered into one row of RGB for each call).
 // Throws emaki::Error naming the layer when its sizes do not match or an input it needs is
 // missing.
 Image<float> composite(const std::vector<LayerInput>& layers, const Paper& paper, int width,

@@ -154,6 +154,60 @@ TEST(Composite, LayerOrderAndBlendModes) {
   EXPECT_FLOAT_EQ(c(0, 0, 2), 0.625f);
 }
 
+// With a working space, only the covered pixels of a layer are converted, and a paper made
+// ahead is used as it is: the same bits as converting every pixel of the paper and the layers.
+TEST(Composite, WorkingSpaceConvertsCoveredPixelsOnly) {
+  const int w = 37, h = 23;
+  Image<float> value(w, h, 2);  // value + mask, a quarter of it uncovered
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      value(x, y, 0) = float((x * 7 + y * 3) % 11) / 10.0f;
+      value(x, y, 1) = (x + y) % 4 == 0 ? 0.0f : float((x + 2 * y) % 5) / 4.0f;
+    }
+  std::vector<LayerInput> layers(2, LayerInput{"a", value.cview(), {}, {}});
+  layers[0].look.flat = {0.9f, 0.4f, 0.2f};
+  layers[1].name = "b";
+  layers[1].look.flat = {0.1f, 0.3f, 0.7f};
+  layers[1].look.blend = BlendMode::kOverlay;
+  Paper paper;
+  paper.color = {0.8f, 0.7f, 0.6f};
+  int64_t converted = 0;
+  const ToWorkingSpace square = [&](ImageView<float> rgb) {
+    for (int y = 0; y < rgb.height; ++y)
+      for (int x = 0; x < rgb.width; ++x)
+        for (int c = 0; c < 3; ++c) rgb(x, y, c) = rgb(x, y, c) * rgb(x, y, c) + 0.01f;
+    converted += int64_t(rgb.width) * rgb.height;
+  };
+  const Image<float> got = composite(layers, paper, w, h, square);
+  EXPECT_LT(converted, int64_t(w) * h * 3);
+  // Every pixel converted, blended as composite() blends.
+  Image<float> want = paper_image(paper, w, h);
+  square(want.view());
+  for (const LayerInput& layer : layers) {
+    Image<float> rgba = color_layer(layer, w, h);
+    square(rgba.view());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) {
+          float& d = want(x, y, c);
+          d = d + rgba(x, y, 3) * (blend(layer.look.blend, d, rgba(x, y, c)) - d);
+        }
+  }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(got(x, y, c), want(x, y, c)) << x << " " << y;
+  // The paper made ahead is not made again.
+  Image<float> made = paper_image(paper, w, h);
+  square(made.view());
+  paper.made = made.cview();
+  converted = 0;
+  const Image<float> again = composite(layers, paper, w, h, square);
+  EXPECT_LT(converted, int64_t(w) * h * 2);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(again(x, y, c), want(x, y, c)) << x << " " << y;
+}
+
 TEST(Composite, MismatchedLayerSizeIsAnError) {
   const Image<float> v = constant(2, 2, {1.0f});
   LayerInput layer{"shadow", v.cview(), {}, {}};

@@ -258,33 +258,6 @@ void resolve_range(const Shot& shot, const RunOptions& o, int& a, int& b) {
 
 }  // namespace
 
-Image<float> composite_frame(const Shot& shot, ImageView<const float> passes,
-                             const std::vector<ImageView<const float>>& layers,
-                             const CompositeInputs& ci) {
-  CHECK_EQ(layers.size(), shot.layers.size());
-  const Image<float> albedo = extract(passes, render::kAlbedo, 3);
-  std::vector<composite::LayerInput> inputs;
-  for (std::size_t i = 0; i < layers.size(); ++i) {
-    composite::LayerInput in;
-    in.name = shot.layers[i].name;
-    in.value = layers[i];
-    in.value_channels = shot.layers[i].single_colour ? 1 : 3;
-    in.albedo = albedo.cview();
-    in.look = shot.layers[i].look;
-    inputs.push_back(in);
-  }
-  composite::Paper paper;
-  paper.texture = ci.paper.empty() ? ImageView<const float>{} : ci.paper.cview();
-  paper.scale = shot.compositing.paper_scale;
-  paper.color = shot.compositing.paper_color;
-  if (shot.compositing.space == CompositingSpace::kDisplay)
-    return composite::composite(inputs, paper, passes.width, passes.height);
-  const colour::Config& config = shot.colour.get();
-  return composite::composite(
-      inputs, paper, passes.width, passes.height,
-      [&](ImageView<float> rgb) { config.convert(rgb, "color_picking", "scene_linear"); });
-}
-
 namespace {
 
 // A layer's value (or a frame's passes) at one frame, kept for the next frame's temporal chain.

@@ -105,9 +105,18 @@ struct RunReport {
   std::vector<Stale> stale;
 };
 
+// The paper as composite_frame last made it (the frame's size, the working space); see
+// CompositeInputs::made_paper.
+struct MadePaper;
+std::shared_ptr<MadePaper> new_made_paper();
+
 // The inputs of compositing that do not change from frame to frame.
 struct CompositeInputs {
   Image<float> paper;  // empty: flat paper colour
+  // The paper made once for every frame (composite::paper_image, in the working space), by the
+  // first composite_frame call; made again when the shot's paper keys, the frame's size or the
+  // working space differ. Copies share it.
+  std::shared_ptr<MadePaper> made_paper = new_made_paper();
 };
 
 // Painted guide weight maps (GuideSpec::map_image) by path: one channel each, the shot's size.
