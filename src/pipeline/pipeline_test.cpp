@@ -290,6 +290,30 @@ TEST(Pipeline, TemporalGuideChangesFramesAfterTheFirst) {
   EXPECT_FALSE(same(2));
 }
 
+// RunOptions::concurrent_layers: the layers that start no chain at a frame (every layer at the
+// first frame, frame-by-frame layers at every frame) made at once give the same values.
+TEST(Pipeline, ConcurrentLayersGiveTheSameFrames) {
+  Shot shot = tiny_shot();
+  shot.layers.push_back(shot.layers[0]);
+  shot.layers[1].name = "second";
+  shot.layers[1].temporal.enabled = false;
+  shot.layers.push_back(shot.layers[1]);
+  shot.layers[2].name = "third";
+  shot.layers[2].synth.seed = 7;
+  const SlidingFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  MemoryStore one, all;
+  run_shot(shot, frames, ex, CompositeInputs{}, one, RunOptions{});
+  RunOptions o;
+  o.concurrent_layers = true;
+  run_shot(shot, frames, ex, CompositeInputs{}, all, o);
+  ASSERT_EQ(one.layers.size(), all.layers.size());
+  for (const auto& [key, a] : one.layers) {
+    const Image<float>& b = all.layers.at(key);
+    EXPECT_EQ(std::memcmp(a.row(0), b.row(0), a.bytes()), 0) << key.first << " " << key.second;
+  }
+}
+
 TEST(Pipeline, ColourLayerTransfersRgbWithItsMask) {
   Shot shot = tiny_shot();
   shot.layers[0].single_colour = false;

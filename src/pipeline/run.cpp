@@ -10,6 +10,7 @@
 #include "composite/composite.h"
 #include "core/error.h"
 #include "core/fnv.h"
+#include "core/parallel.h"
 #include "core/rng.h"
 #include "core/shot_keys.h"
 #include "pipeline/qa_maps.h"
@@ -358,6 +359,7 @@ class ShotRun {
   bool synthesize_frame(int f, std::vector<Held>& now) {
     bool changed = false;
     AdvectionFields fields;
+    std::vector<std::optional<LayerFrame>> made = independent_layers(f);
     for (std::size_t i = 0; i < prepared_.size(); ++i) {
       const Layer& l = *prepared_[i].layer;
       now[i].frame = f;
@@ -381,9 +383,10 @@ class ShotRun {
       }
       const ImageView<const int32_t> previous_nnf =
           previous && held_[i].frame == f - 1 ? held_[i].nnf.cview() : ImageView<const int32_t>{};
-      tick(f, l.name);
-      LayerFrame r = synthesize_layer(prepared_[i], passes(f).cview(), f, previous, previous_passes,
-                                      previous_nnf, &fields, &o_);
+      if (!made[i]) tick(f, l.name);
+      LayerFrame r = made[i] ? std::move(*made[i])
+                             : synthesize_layer(prepared_[i], passes(f).cview(), f, previous,
+                                                previous_passes, previous_nnf, &fields, &o_);
       if (!r.error.empty())
         store_.write_qa_map("error", l, f,
                             synthesis_error_map(r.error.cview(), r.value.cview(),
@@ -403,6 +406,28 @@ class ShotRun {
       changed = true;
     }
     return changed;
+  }
+
+  // With RunOptions::concurrent_layers, the layers frame f needs that do not continue a chain
+  // there, synthesized at once (parallel to prepared_; the others stay empty).
+  std::vector<std::optional<LayerFrame>> independent_layers(int f) {
+    std::vector<std::optional<LayerFrame>> made(prepared_.size());
+    std::vector<std::size_t> alone;
+    for (std::size_t i = 0; i < prepared_.size(); ++i) {
+      const Layer& l = *prepared_[i].layer;
+      if (needs(l, f) && !(l.temporal.enabled && f > first_)) alone.push_back(i);
+    }
+    if (!o_.concurrent_layers || alone.size() < 2) return made;
+    const ImageView<const float> p = passes(f).cview();
+    for (std::size_t i : alone) tick(f, prepared_[i].layer->name);
+    parallel_for(int64_t(alone.size()), 1, [&](int64_t a, int64_t b) {
+      for (int64_t k = a; k < b; ++k) {
+        AdvectionFields fields;  // unused without a predecessor
+        made[alone[k]] = synthesize_layer(prepared_[alone[k]], p, f, nullptr, nullptr, {},
+                                          &fields, &o_);
+      }
+    });
+    return made;
   }
 
   // Before a forced run's last frame f of a temporal layer replaces the finished one: when the

@@ -58,7 +58,11 @@ void Rerun::watch(std::string seen) {
     seen = std::move(now);
     ++m_saves;
     m_pending = true;
-    m_last_save = std::chrono::steady_clock::now();
+    const auto t = std::chrono::steady_clock::now();
+    // A save after a quiet time, with no run going, starts a run at once (the first save of a
+    // burst); a save within `settle` of the last one waits for the burst to end.
+    m_leading = !m_running && t - m_last_save >= m_options.settle;
+    m_last_save = t;
     if (m_running) m_stale = true;
     m_wake.notify_all();
   }
@@ -72,11 +76,11 @@ void Rerun::run_loop() {
       m_wake.wait(lock);
       continue;
     }
-    if (std::chrono::steady_clock::now() < due) {
+    if (!m_leading && std::chrono::steady_clock::now() < due) {
       m_wake.wait_until(lock, due);
       continue;
     }
-    m_pending = false;
+    m_pending = m_leading = false;
     m_stale = false;
     m_running = true;
     ++m_started;

@@ -1,8 +1,8 @@
 // emaki lookdev's loop: watch a few files (polling their modification time, size and inode, so
-// an editor's save-by-rename counts), and run the work once the saves have settled. A save that
-// comes while the work runs marks that run stale (the work polls `stale` and stops early); the
-// next run starts when the saves settle again. A burst of saves therefore costs at most the run
-// in progress and one more.
+// an editor's save-by-rename counts), and run the work on a save: at once for a save after a
+// quiet time, else once the saves have settled. A save that comes while the work runs marks that
+// run stale (the work polls `stale` and stops early); the next run starts when the saves settle
+// again. A burst of saves therefore costs at most the run its first save started and one more.
 #pragma once
 
 #include <atomic>
@@ -18,7 +18,7 @@
 namespace emaki::view {
 
 struct RerunOptions {
-  std::chrono::milliseconds poll{50};     // how often the files are looked at
+  std::chrono::milliseconds poll{25};     // how often the files are looked at
   std::chrono::milliseconds settle{150};  // quiet time after the last save before a run
 };
 
@@ -50,7 +50,7 @@ class Rerun {
   RerunOptions m_options;
   std::mutex m_mutex;
   std::condition_variable m_wake;
-  bool m_pending = true, m_stopping = false;
+  bool m_pending = true, m_stopping = false, m_leading = false;
   std::chrono::steady_clock::time_point m_last_save{};
   std::atomic<bool> m_stale{false}, m_running{false};
   std::atomic<int> m_started{0}, m_finished{0}, m_saves{0};

@@ -87,5 +87,27 @@ TEST(Rerun, ASaveDuringARunMakesItStaleAndRunsAgain) {
   fs::remove(f);
 }
 
+TEST(Rerun, ASaveAfterAQuietTimeRunsAtOnceAndABurstWaitsForItsEnd) {
+  const fs::path f = test_file("leading");
+  RerunOptions o;
+  o.settle = 3s;  // long, so that "at once" and "after the burst" cannot be confused
+  Rerun r({f}, [](const std::atomic<bool>&) {}, o);
+  r.start();
+  wait_for([&] { return r.runs_finished() == 1; });
+  const auto t0 = std::chrono::steady_clock::now();
+  save(f, 1);
+  wait_for([&] { return r.runs_started() == 2; });
+  EXPECT_EQ(r.runs_started(), 2);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 2500ms) << "the first save waited to settle";
+  // A second save right after: within the settle of the first, it waits for the burst's end.
+  save(f, 2);
+  std::this_thread::sleep_for(1000ms);
+  EXPECT_EQ(r.runs_started(), 2);
+  wait_for([&] { return r.runs_finished() == 3; });
+  EXPECT_EQ(r.runs_finished(), 3);
+  r.stop();
+  fs::remove(f);
+}
+
 }  // namespace
 }  // namespace emaki::view

@@ -166,6 +166,20 @@ async function poll() {
   }
 }
 
+// emaki lookdev's status (a few bytes) is asked for ten times a second, and the outputs as
+// soon as its run count moves on, so a new preview frame shows within 0.1 s of being written;
+// the outputs themselves are listed once a second (a farm or `emaki run` writing frames).
+let generation;
+async function pollStatus() {
+  try {
+    const s = await (await fetch("api/status", { cache: "no-store" })).json();
+    $("status").textContent = s.message || "";
+    if (s.generation === undefined || s.generation === generation) return;
+    generation = s.generation;
+    await poll();
+  } catch (e) {}
+}
+
 function keys(e) {
   if (e.target.tagName === "SELECT" || e.target.tagName === "INPUT" && e.target.type !== "range")
     return;
@@ -191,4 +205,5 @@ $("stage").addEventListener("pointermove", (e) => {
 $("img-a").onload = renderCompare;
 setInterval(() => { if (state.playing) step(1); }, 1000 / 12);
 setInterval(poll, 1000);
+setInterval(pollStatus, 100);
 poll();
