@@ -138,7 +138,7 @@ bool run_frames(const LookdevOptions& o, const std::vector<int>& frames,
     if (o.temporal && f > s.source.first_frame) r.first_frame = r.chain_from = f - 1;
     r.force = true;
     r.previews = false;
-    r.error_maps = true;  // the page's overlay: where the painting has no good match
+    r.error_maps = true;         // the page's overlay: where the painting has no good match
     r.concurrent_layers = true;  // a preview frame is small: its layers at once fill the cores
     r.cancel = [&] { return stale.load(); };  // a save stops the synthesis in progress too
     r.progress = [&](const pipeline::Progress& p) {

@@ -423,8 +423,8 @@ class ShotRun {
     parallel_for(int64_t(alone.size()), 1, [&](int64_t a, int64_t b) {
       for (int64_t k = a; k < b; ++k) {
         AdvectionFields fields;  // unused without a predecessor
-        made[alone[k]] = synthesize_layer(prepared_[alone[k]], p, f, nullptr, nullptr, {},
-                                          &fields, &o_);
+        made[alone[k]] =
+            synthesize_layer(prepared_[alone[k]], p, f, nullptr, nullptr, {}, &fields, &o_);
       }
     });
     return made;

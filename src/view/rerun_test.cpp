@@ -91,7 +91,8 @@ TEST(Rerun, ASaveAfterAQuietTimeRunsAtOnceAndABurstWaitsForItsEnd) {
   const fs::path f = test_file("leading");
   RerunOptions o;
   o.settle = 3s;  // long, so that "at once" and "after the burst" cannot be confused
-  Rerun r({f}, [](const std::atomic<bool>&) {}, o);
+  Rerun r(
+      {f}, [](const std::atomic<bool>&) {}, o);
   r.start();
   wait_for([&] { return r.runs_finished() == 1; });
   const auto t0 = std::chrono::steady_clock::now();
