@@ -239,6 +239,13 @@ Image<float> studio_passes(const Shot& shot, const pipeline::Exemplar& e, int w,
       for (int x = 0; x < w; ++x)
         for (std::size_t i = 0; i < into.size(); ++i) passes(x, y, into[i]) = pass(x, y, int(i));
   }
+  // Its albedo is a studio render's, in source.passes_colorspace, as the shot's frames are.
+  if (std::find(into.begin(), into.end(), int(render::kAlbedo)) != into.end()) {
+    ImageView<float> albedo = passes.view();
+    albedo.data += render::kAlbedo;
+    albedo.channels = passes.channels();  // the pixel step; convert() touches the first three
+    shot.colour.get().convert(albedo, shot.source.passes_colorspace, "scene_linear");
+  }
   return passes;
 }
 
