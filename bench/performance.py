@@ -227,6 +227,7 @@ def section_shot(a, build):
                 steps.setdefault(name, []).append(float(s))
         split = ", ".join(f"{n} {statistics.median(v):.2f}" for n, v in steps.items())
         rows.append(f"| {size} | {f0:.2f} | {ft:.2f} | {split} |")
+        TEMPORAL_FRAME[size] = ft
     lines += ["```", "",
               "| size | frame 0 s | temporal frame s | per temporal frame, by step (s) |",
               "|---|---|---|---|"] + rows
@@ -329,7 +330,63 @@ def section_python(a, build, emaki, tmp):
                 else "to be compared with")]
 
 
-SECTIONS = ("synth", "scaling", "memory", "render", "shot", "run", "temporal", "python")
+SECTIONS = ("synth", "scaling", "memory", "render", "shot", "colour", "run", "temporal",
+            "lookdev", "plan", "python")
+TEMPORAL_FRAME = {}  # size -> the shot section's temporal frame seconds
+
+
+def section_colour(a, build):
+    size = "960x540"
+    if size not in TEMPORAL_FRAME:
+        out = run_timed([os.path.join(build, "bench", "shot_bench"), size, "4"],
+                        env={"GLIBC_TUNABLES": HUGE_ON})["out"]
+        TEMPORAL_FRAME[size] = float(re.search(r"\(temporal\) ([0-9.]+) s", out).group(1))
+    cmd = [os.path.join(build, "bench", "colour_bench"), size, f"{TEMPORAL_FRAME[size]:.2f}", "10"]
+    out = run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON})["out"]
+    rows = []
+    for label, name in (("passes: albedo ACEScg -> scene_linear", "passes"),
+                        ("compositing.space = scene_linear: composite_frame's extra", "compositing"),
+                        ("composite PNG: scene_linear -> sRGB / Filmic", "Filmic PNG")):
+        m = re.search(re.escape(label) + r"\s+([0-9.]+) ms /\s+([0-9.]+) ms", out)
+        rows.append(f"| {name} | {float(m.group(1)):.1f} | {float(m.group(2)):.1f} |")
+    m = re.search(r"per frame: ([0-9.]+) ms, ([0-9.]+) %", out)
+    return ["## Colour management", "",
+            "The most colour management a shot can ask for (ACEScg studio passes, `scene_linear` "
+            "compositing, the Filmic view on the composite PNG), on the bundled shot's frame 0 at "
+            "960x540, best of 10; the defaults cost nothing:", "", "```sh", shown(cmd), "```", "",
+            "| step | wall ms | CPU ms |", "|---|---|---|"] + rows + [
+            "", f"{float(m.group(1)):.1f} ms a frame: {m.group(2)} % of the temporal frame above "
+            f"({TEMPORAL_FRAME[size]:.2f} s)."]
+
+
+def section_lookdev(a, build):
+    emaki = os.path.join(build, "apps", "emaki", "emaki")
+    cmd = ["sh", os.path.join(ROOT, "bench", "lookdev_bench.sh"), emaki, "5"]
+    out = run_timed(cmd)["out"]
+    saves = re.findall(r"save to frame written ([0-9.]+) s \(run ([0-9.]+) s, CPU ([0-9.]+) s\)",
+                       out)
+    rows = [f"| {i + 1} | {float(w):.2f} | {float(r):.2f} | {float(c):.2f} |"
+            for i, (w, r, c) in enumerate(saves)]
+    return ["## Look development", "",
+            "`emaki lookdev` on the bundled shot at `--scale 0.5` (480x270), frame 0: five saves "
+            "of the painting, each timed from the save to the new frame written (the page asks "
+            "for it every 0.1 s):", "", "```sh", shown(cmd), "```", "",
+            "| save | save to frame s | making it s | CPU s |", "|---|---|---|---|"] + rows
+
+
+def section_plan(a, build):
+    cmd = [os.path.join(build, "bench", "plan_bench"), "100000", "1000000"]
+    out = run_timed(cmd)["out"]
+    rows = []
+    for m in re.finditer(r"(\d+) frames: (\d+) tasks, (\d+) dependencies: plan ([0-9.]+) s "
+                         r"\(CPU ([0-9.]+) s\), json ([0-9.]+) s \(CPU ([0-9.]+) s, ([0-9.]+) MB\)",
+                         out):
+        fr, tasks, deps, pw, pc, jw, jc, mb = m.groups()
+        rows.append(f"| {int(fr):,} | {int(tasks):,} | {float(pw):.3f} | {float(jw):.3f} | {mb} |")
+    return ["## Planning a long shot", "",
+            "`emaki plan` of a production shot (two temporal layers, chunks of 8) stretched to "
+            "10^5 and 10^6 frames, every task to do:", "", "```sh", shown(cmd), "```", "",
+            "| frames | tasks | task graph s | JSON s | JSON MB |", "|---|---|---|---|---|"] + rows
 
 
 def printed_arguments(argv):
@@ -382,6 +439,12 @@ def main():
                 lines += section_run(a, emaki, tmp)
             elif name == "temporal":
                 lines += section_temporal(a, build)
+            elif name == "colour":
+                lines += section_colour(a, build)
+            elif name == "lookdev":
+                lines += section_lookdev(a, build)
+            elif name == "plan":
+                lines += section_plan(a, build)
             else:
                 lines += section_python(a, build, emaki, tmp)
             lines.append("")
@@ -409,9 +472,6 @@ def main():
         "- `bench/temporal_bench`: one layer of a shot run several ways (frame by frame, advection "
         "guides, confidence, uniformity, warm start, temporal weight), flicker, ghosts, drift and "
         "the judge ([guide.md](guide.md#reading-qa)).",
-        "- `bench/colour_bench [WxH] [SECONDS]`: the most colour management can add to a frame "
-        "(ACEScg passes, `scene_linear` compositing, the Filmic view), beside a temporal frame's "
-        "time from `shot_bench` ([shot_file.md](shot_file.md#colour-management)).",
         "- `bench/python_overhead.py` (the module's cost over the command line's synthesis, in "
         "instructions with `--instructions`) and `bench/python_gil.py` (two Python threads "
         "synthesizing at once).",
