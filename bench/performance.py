@@ -389,6 +389,22 @@ def section_plan(a, build):
             "| frames | tasks | task graph s | JSON s | JSON MB |", "|---|---|---|---|---|"] + rows
 
 
+# Each section's function, called with (args, build folder, emaki, scratch folder).
+SECTION_RUNS = {
+    "synth": lambda a, b, e, t: section_synth(a, e, t),
+    "scaling": lambda a, b, e, t: section_scaling(a, b),
+    "memory": lambda a, b, e, t: section_memory(a, e, t),
+    "render": lambda a, b, e, t: section_render(a, b),
+    "shot": lambda a, b, e, t: section_shot(a, b),
+    "colour": lambda a, b, e, t: section_colour(a, b),
+    "run": lambda a, b, e, t: section_run(a, e, t),
+    "temporal": lambda a, b, e, t: section_temporal(a, b),
+    "lookdev": lambda a, b, e, t: section_lookdev(a, b),
+    "plan": lambda a, b, e, t: section_plan(a, b),
+    "python": lambda a, b, e, t: section_python(a, b, e, t),
+}
+
+
 def printed_arguments(argv):
     """The command line as the page shows it, with every path replaced by PATH."""
     argv = list(argv)
@@ -425,28 +441,7 @@ def main():
             if name not in only:
                 continue
             print(f"performance.py: {name} ...", file=sys.stderr)
-            if name == "synth":
-                lines += section_synth(a, emaki, tmp)
-            elif name == "scaling":
-                lines += section_scaling(a, build)
-            elif name == "memory":
-                lines += section_memory(a, emaki, tmp)
-            elif name == "render":
-                lines += section_render(a, build)
-            elif name == "shot":
-                lines += section_shot(a, build)
-            elif name == "run":
-                lines += section_run(a, emaki, tmp)
-            elif name == "temporal":
-                lines += section_temporal(a, build)
-            elif name == "colour":
-                lines += section_colour(a, build)
-            elif name == "lookdev":
-                lines += section_lookdev(a, build)
-            elif name == "plan":
-                lines += section_plan(a, build)
-            else:
-                lines += section_python(a, build, emaki, tmp)
+            lines += SECTION_RUNS[name](a, build, emaki, tmp)
             lines.append("")
     args = printed_arguments(sys.argv[1:])
     header = [
