@@ -15,7 +15,7 @@
 //                  [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N]
 //                  [--temporal-weight W] [--temporal-uniformity U]
 //                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--save DIR]
-//                  [--threads N]
+//                  [--threads N] [--painting-scale S]
 //
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
@@ -73,6 +73,7 @@ struct Options {
   temporal::ConfidenceParams confidence;
   bool confidence_set = false;        // any of --error-*, --foreign-none, --erode given
   float temporal_weight = -1.0f;      // -1: the example's
+  double painting_scale = 1.0;        // the paintings resampled by this (Exemplar::scale)
   float temporal_uniformity = -1.0f;  // for `_uniform` variants; -1: the layer's uniformity
 };
 
@@ -83,7 +84,7 @@ struct Options {
       "NAME] "
       "[--variants a,b,...] [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N] "
       "[--temporal-weight W] [--temporal-uniformity U] [--judge PATH] "
-      "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N]\n",
+      "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N] [--painting-scale S]\n",
       why.c_str());
   std::exit(2);
 }
@@ -156,6 +157,8 @@ Options parse(int argc, char** argv) {
       o.save = v;
     } else if (a == "--threads") {
       o.threads = std::atoi(v.c_str());
+    } else if (a == "--painting-scale") {
+      o.painting_scale = std::strtod(v.c_str(), nullptr);
     } else {
       usage("unknown option " + a);
     }
@@ -331,6 +334,8 @@ pipeline::Shot example(const Options& opt, pipeline::Layer*& layer) {
   }
   shot.source.last_frame = shot.source.first_frame + opt.frames - 1;
   shot.source.shot.last_frame = shot.source.last_frame;
+  for (pipeline::Exemplar& e : shot.exemplars)
+    if (e.kind == pipeline::ExemplarKind::kMatcap) e.scale = opt.painting_scale;
   layer = nullptr;
   for (pipeline::Layer& l : shot.layers)
     if (l.name == opt.layer) layer = &l;
