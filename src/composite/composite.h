@@ -110,7 +110,8 @@ Image<float> color_layer(const LayerInput& layer, int width, int height);
 Image<float> paper_image(const Paper& paper, int width, int height);
 
 // Converts an image's RGB (its first three channels) in place, e.g. from display-referred values
-// to scene-linear ones (colour/colour.h does it; this module knows no colour space).
+// to scene-linear ones (colour/colour.h does it; this module knows no colour space). composite()
+// calls it from several threads at once, each on its own rows.
 using ToWorkingSpace = std::function<void(ImageView<float>)>;
 
 // Paper, then every layer from first (bottom) to last (top). Returns RGBA with alpha 1.
