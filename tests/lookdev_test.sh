@@ -23,6 +23,7 @@ wait_for() {
     i=$((i + 1))
     [ $i -lt 3000 ] || { echo "FAIL: no '$1' within 300 s"; cat "$work/log"; exit 1; }
     kill -0 $pid 2>/dev/null || { echo "FAIL: lookdev stopped"; cat "$work/log"; exit 1; }
+    ! status | grep -q '"message":"error: ' || { echo "FAIL: $(status)"; exit 1; }
     sleep 0.1
   done
 }

@@ -31,30 +31,34 @@ struct Config::Impl {
   // The conversions of images (convert, to_display), run as steps (colour/steps.h).
   mutable std::map<std::string, std::shared_ptr<const Steps>> conversions;
 
-  OCIO::ConstCPUProcessorRcPtr processor(const std::string& cache_key,
-                                         const std::function<OCIO::ConstProcessorRcPtr()>& make,
-                                         const std::string& what) const {
+  // `cache`'s entry under `key`, made by `make` the first time (an OCIO failure to make it is an
+  // error naming `what`).
+  template <typename V>
+  V cached(std::map<std::string, V>& cache, const std::string& key, const std::function<V()>& make,
+           const std::string& what) const {
     const std::lock_guard<std::mutex> lock(mutex);
-    auto it = processors.find(cache_key);
-    if (it != processors.end()) return it->second;
+    auto it = cache.find(key);
+    if (it != cache.end()) return it->second;
     try {
-      return processors[cache_key] = make()->getDefaultCPUProcessor();
+      return cache[key] = make();
     } catch (const OCIO::Exception& e) {
       throw Error(origin, fmt::format("cannot convert {}: {}", what, e.what()));
     }
   }
 
+  OCIO::ConstCPUProcessorRcPtr processor(const std::string& cache_key,
+                                         const std::function<OCIO::ConstProcessorRcPtr()>& make,
+                                         const std::string& what) const {
+    return cached<OCIO::ConstCPUProcessorRcPtr>(
+        processors, cache_key, [&] { return make()->getDefaultCPUProcessor(); }, what);
+  }
+
   std::shared_ptr<const Steps> conversion(const std::string& cache_key,
                                           const std::function<OCIO::ConstProcessorRcPtr()>& make,
                                           const std::string& what) const {
-    const std::lock_guard<std::mutex> lock(mutex);
-    auto it = conversions.find(cache_key);
-    if (it != conversions.end()) return it->second;
-    try {
-      return conversions[cache_key] = std::make_shared<const Steps>(config, make());
-    } catch (const OCIO::Exception& e) {
-      throw Error(origin, fmt::format("cannot convert {}: {}", what, e.what()));
-    }
+    return cached<std::shared_ptr<const Steps>>(
+        conversions, cache_key, [&] { return std::make_shared<const Steps>(config, make()); },
+        what);
   }
 };
 
