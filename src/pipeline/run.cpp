@@ -309,6 +309,8 @@ class ShotRun {
   bool needs(const Layer& l, int f) const {
     return (o_.force && f >= a_) || !store_.has_layer(l, f);
   }
+  // Whether `l` at frame f is made from its frame f - 1 (the temporal guide, the warm start).
+  bool continues_chain(const Layer& l, int f) const { return l.temporal.enabled && f > first_; }
 
   // With temporal_fields = "last" a layer keeps one field: the last finished frame's, what a
   // resumed run starts from. The loop above drops f - 1's as it goes; this also drops what a
@@ -369,7 +371,7 @@ class ShotRun {
       }
       const Image<float>* previous = nullptr;
       const Image<float>* previous_passes = nullptr;
-      if (l.temporal.enabled && f > first_) {
+      if (continues_chain(l, f)) {
         if (held_[i].frame != f - 1 || held_[i].value.empty()) {
           held_[i].frame = f - 1;
           held_[i].value = store_.read_layer(l, f - 1);
@@ -415,7 +417,7 @@ class ShotRun {
     std::vector<std::size_t> alone;
     for (std::size_t i = 0; i < prepared_.size(); ++i) {
       const Layer& l = *prepared_[i].layer;
-      if (needs(l, f) && !(l.temporal.enabled && f > first_)) alone.push_back(i);
+      if (needs(l, f) && !continues_chain(l, f)) alone.push_back(i);
     }
     if (!o_.concurrent_layers || alone.size() < 2) return made;
     const ImageView<const float> p = passes(f).cview();

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 
+#include "colour/colour.h"
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/resample.h"
@@ -95,18 +96,24 @@ Image<float> rgb_of(const std::string& key, const std::string& path, InputCache*
       key, fmt::format("'{}' has {} channels; expected grey, RGB or RGBA", path, img.channels()));
 }
 
-// A studio render's frames with their albedo converted from source.passes_colorspace to the
-// config's scene_linear (what emaki's renderer writes); the data passes are left as they are.
+// The albedo of a studio render's passes (all of render's channels) converted from `space` to
+// the config's scene_linear (what emaki's renderer writes); the data passes are left as they are.
+void albedo_to_scene_linear(const colour::Config& colour, const std::string& space,
+                            Image<float>& passes) {
+  ImageView<float> albedo = passes.view();
+  albedo.data += render::kAlbedo;
+  albedo.channels = passes.channels();  // the pixel step; convert() touches the first three
+  colour.convert(albedo, space, "scene_linear");
+}
+
+// A studio render's frames, their albedo from source.passes_colorspace to scene_linear.
 class ColourConvertedFrames : public pipeline::FrameSource {
  public:
   ColourConvertedFrames(const Shot& shot, std::unique_ptr<pipeline::FrameSource> inner)
       : colour_(shot.colour), space_(shot.source.passes_colorspace), inner_(std::move(inner)) {}
   Image<float> passes(int frame) const override {
     Image<float> p = inner_->passes(frame);
-    ImageView<float> albedo = p.view();
-    albedo.data += render::kAlbedo;
-    albedo.channels = p.channels();  // the pixel step; convert() touches the first three
-    colour_.get().convert(albedo, space_, "scene_linear");
+    albedo_to_scene_linear(colour_.get(), space_, p);
     return p;
   }
 
@@ -240,12 +247,8 @@ Image<float> studio_passes(const Shot& shot, const pipeline::Exemplar& e, int w,
         for (std::size_t i = 0; i < into.size(); ++i) passes(x, y, into[i]) = pass(x, y, int(i));
   }
   // Its albedo is a studio render's, in source.passes_colorspace, as the shot's frames are.
-  if (std::find(into.begin(), into.end(), int(render::kAlbedo)) != into.end()) {
-    ImageView<float> albedo = passes.view();
-    albedo.data += render::kAlbedo;
-    albedo.channels = passes.channels();  // the pixel step; convert() touches the first three
-    shot.colour.get().convert(albedo, shot.source.passes_colorspace, "scene_linear");
-  }
+  if (std::find(into.begin(), into.end(), int(render::kAlbedo)) != into.end())
+    albedo_to_scene_linear(shot.colour.get(), shot.source.passes_colorspace, passes);
   return passes;
 }
 
