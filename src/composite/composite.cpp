@@ -235,14 +235,16 @@ Image<float> paper_image(const Paper& paper, int width, int height) {
 namespace {
 
 // `to_working` on the pixels of `rgba` with alpha > 0: a row band's are gathered into one row
-// of RGB, converted, put back. Each pixel's conversion is its own, so this gives what converting
-// all of them gives where it matters. The band's buffers are its own, not the thread's: a
-// conversion that runs parallel work of its own may have this thread take another band
-// meanwhile.
+// of RGB (a scratch buffer per thread), converted, put back. Each pixel's conversion is its
+// own, so this gives what converting all of them gives where it matters. The conversion runs
+// isolated: were it to run parallel work, this thread must not take another band meanwhile and
+// overwrite the scratch.
 void to_working_where_covered(ImageView<float> rgba, const ToWorkingSpace& to_working) {
   parallel_rows(rgba.height, 16, [&](int y0, int y1) {
-    std::vector<float*> where;
-    std::vector<float> rgb;
+    thread_local std::vector<float*> where;
+    thread_local std::vector<float> rgb;
+    where.clear();
+    rgb.clear();
     for (int y = y0; y < y1; ++y) {
       float* p = rgba.row(y);
       for (int x = 0; x < rgba.width; ++x, p += rgba.channels)
@@ -253,7 +255,7 @@ void to_working_where_covered(ImageView<float> rgba, const ToWorkingSpace& to_wo
     }
     if (where.empty()) return;
     const int n = int(where.size());
-    to_working(ImageView<float>{rgb.data(), n, 1, 3, std::ptrdiff_t(n) * 3});
+    isolated([&] { to_working(ImageView<float>{rgb.data(), n, 1, 3, std::ptrdiff_t(n) * 3}); });
     for (int i = 0; i < n; ++i)
       std::copy_n(rgb.data() + std::ptrdiff_t(i) * 3, 3, where[std::size_t(i)]);
   });

@@ -132,4 +132,12 @@ void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, in
   });
 }
 
+void isolated(const std::function<void()>& fn) {
+#if defined(__SANITIZE_THREAD__)
+  fn();  // parallel_for runs plain threads there: a waiting thread takes no other task
+#else
+  tbb::this_task_arena::isolate([&] { fn(); });
+#endif
+}
+
 }  // namespace emaki

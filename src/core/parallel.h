@@ -33,6 +33,11 @@ class ScopedThreadCount {
 // pixel budget (core/limits.h) holds inside fn on every worker thread.
 void parallel_for(int64_t n, int64_t grain, const std::function<void(int64_t, int64_t)>& fn);
 
+// Calls fn() so that the parallel work it starts never has this thread run other tasks of the
+// loops around it meanwhile (TBB lets a waiting thread take any pending task): for a loop body
+// that holds per-thread scratch across a call that may itself run parallel work.
+void isolated(const std::function<void()>& fn);
+
 // Calls fn(y0, y1) over row bands of `band` rows.
 inline void parallel_rows(int height, int band, const std::function<void(int, int)>& fn) {
   parallel_for(height, band, [&](int64_t a, int64_t b) { fn(int(a), int(b)); });
