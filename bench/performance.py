@@ -355,8 +355,8 @@ def section_colour(a, build):
             "compositing, the Filmic view on the composite PNG), on the bundled shot's frame 0 at "
             "960x540, best of 10; the defaults cost nothing:", "", "```sh", shown(cmd), "```", "",
             "| step | wall ms | CPU ms |", "|---|---|---|"] + rows + [
-            "", f"{float(m.group(1)):.1f} ms a frame: {m.group(2)} % of the temporal frame above "
-            f"({TEMPORAL_FRAME[size]:.2f} s)."]
+            "", f"{float(m.group(1)):.1f} ms a frame: {m.group(2)} % of a temporal frame "
+            f"(`shot_bench {size}`: {TEMPORAL_FRAME[size]:.2f} s)."]
 
 
 def section_lookdev(a, build):
@@ -381,7 +381,7 @@ def section_plan(a, build):
     for m in re.finditer(r"(\d+) frames: (\d+) tasks, (\d+) dependencies: plan ([0-9.]+) s "
                          r"\(CPU ([0-9.]+) s\), json ([0-9.]+) s \(CPU ([0-9.]+) s, ([0-9.]+) MB\)",
                          out):
-        fr, tasks, deps, pw, pc, jw, jc, mb = m.groups()
+        fr, tasks, _, pw, _, jw, _, mb = m.groups()
         rows.append(f"| {int(fr):,} | {int(tasks):,} | {float(pw):.3f} | {float(jw):.3f} | {mb} |")
     return ["## Planning a long shot", "",
             "`emaki plan` of a production shot (two temporal layers, chunks of 8) stretched to "

@@ -1,9 +1,9 @@
 // `emaki lookdev SHOT --frames 0,24,47 [--scale 0.5]`: a few frames of a shot at preview size,
 // made again whenever the painting(s), the shot file or the passes are saved, on emaki view's
 // page (src/view/). Frames run frame by frame (no temporal chain), or with --temporal each from
-// its predecessor made frame by frame, into their own folder; a save
-// during a run stops it (within the synthesis in progress: the engine's cancel hook) and the run
-// starts over once the saves settle.
+// its predecessor made frame by frame, into their own folder. A save after a quiet time starts
+// a run at once; a save during a run stops it (within the synthesis in progress: the engine's
+// cancel hook) and the run starts over once the saves settle.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
