@@ -61,13 +61,6 @@ Best best_of(int repeats, const std::function<void()>& prepare, const std::funct
   return b;
 }
 
-Image<float> copy_of(ImageView<const float> v) {
-  Image<float> out(v.width, v.height, v.channels);
-  for (int y = 0; y < v.height; ++y)
-    std::copy_n(v.row(y), std::size_t(v.width) * v.channels, out.row(y));
-  return out;
-}
-
 // What each layer covers: what compositing converts (composite/composite.h).
 void print_coverage(const pipeline::Shot& shot, ImageView<const float> passes,
                     const std::vector<ImageView<const float>>& layers) {
@@ -155,14 +148,14 @@ int main(int argc, char** argv) {
       total += b.wall;
     };
     Image<float> p;
-    report("passes: albedo ACEScg -> scene_linear",
-           best_of(
-               repeats, [&] { p = copy_of(passes.cview()); },
-               [&] {
-                 ImageView<float> albedo = p.view();
-                 albedo.data += render::kAlbedo;
-                 config.convert(albedo, colour::kAcescg, "scene_linear");
-               }));
+    report("passes: albedo ACEScg -> scene_linear", best_of(
+                                                        repeats, [&] { p = passes.clone(); },
+                                                        [&] {
+                                                          ImageView<float> albedo = p.view();
+                                                          albedo.data += render::kAlbedo;
+                                                          config.convert(albedo, colour::kAcescg,
+                                                                         "scene_linear");
+                                                        }));
     Image<float> comp;
     report("compositing.space = scene_linear: composite_frame's extra",
            compositing_extra(shot, passes.cview(), layers, repeats, comp));
