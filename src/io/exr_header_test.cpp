@@ -4,6 +4,7 @@
 #include "io/exr_header.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -25,7 +26,9 @@ namespace fs = std::filesystem;
 
 // A small float EXR as emaki writes it, as bytes.
 std::vector<unsigned char> small_exr() {
-  const fs::path path = fs::temp_directory_path() / "emaki_exr_header_test.exr";
+  // One file per process: ctest runs this file's tests side by side.
+  const fs::path path =
+      fs::temp_directory_path() / ("emaki_exr_header_test_" + std::to_string(::getpid()) + ".exr");
   Image<float> im(6, 4, 3);
   WriteOptions o;
   o.format = SampleFormat::kFloat;
