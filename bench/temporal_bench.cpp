@@ -262,7 +262,8 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
   }
 }
 
-// The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma), u=U (temporal
+// The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma), x=X (the warm start's
+// sharp estimate; s and x unset: from the frame's size against the painting's), u=U (temporal
 // uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
@@ -274,6 +275,8 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
     const float x = std::strtof(value.c_str(), nullptr);
     if (key == "s") {
       l.temporal.guide_sigma = x;
+    } else if (key == "x") {
+      l.temporal.sharp_estimate = x;
     } else if (key == "u") {
       l.temporal.uniformity = x;
     } else if (key == "w") {

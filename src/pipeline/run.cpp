@@ -36,10 +36,12 @@ struct PreparedLayer {
   std::vector<std::shared_ptr<const Image<float>>> source_guides;
   std::vector<const Image<float>*> painted_maps;  // per guide: its painted weight map, or null
   Image<float> temporal_style;  // A' low-passed for the temporal guide (guide_sigma), or empty
-  AnchorExemplar anchor;        // the tone anchor's exemplar side (TemporalSpec::anchor), or empty
+  TemporalSharpening sharpening;
+  AnchorExemplar anchor;  // the tone anchor's exemplar side (TemporalSpec::anchor), or empty
 };
 
-PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const WeightMapImages& maps) {
+PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const WeightMapImages& maps,
+                      int frame_width, int frame_height) {
   PreparedLayer p;
   p.layer = &layer;
   p.value_channels = layer.single_colour ? 1 : 3;
@@ -61,8 +63,10 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
     CHECK(g.map_image.empty() || it != maps.end());  // shot::load_weight_maps read every one
     p.painted_maps.push_back(it == maps.end() ? nullptr : &it->second);
   }
-  if (layer.temporal.enabled && layer.temporal.guide_sigma > 0.0f)
-    p.temporal_style = temporal::low_pass(p.style.cview(), layer.temporal.guide_sigma);
+  p.sharpening = temporal_sharpening(layer.temporal, frame_width, frame_height, p.style.width(),
+                                     p.style.height());
+  if (layer.temporal.enabled && p.sharpening.guide_sigma > 0.0f)
+    p.temporal_style = temporal::low_pass(p.style.cview(), p.sharpening.guide_sigma);
   if (layer.temporal.enabled && layer.temporal.anchor > 0) {
     std::vector<synth::Plane> sources;
     for (const auto& g : p.source_guides) sources.push_back(g->cview());
@@ -106,9 +110,9 @@ void add_temporal_guide(const PreparedLayer& p, ImageView<const float> passes,
   const Layer& l = *p.layer;
   t.advected =
       advect_layer(l, passes, mask, previous.cview(), previous_passes.cview(), frame, fields);
-  const bool low = l.temporal.guide_sigma > 0.0f;
+  const bool low = p.sharpening.guide_sigma > 0.0f;
   if (low)
-    t.target = temporal::low_pass(t.advected.value.cview(), l.temporal.guide_sigma,
+    t.target = temporal::low_pass(t.advected.value.cview(), p.sharpening.guide_sigma,
                                   mask.empty() ? ImageView<const float>{} : mask.cview());
   synth::GuidePair pair{shot_keys::layer_key(l.name, shot_keys::kTemporal),
                         low ? p.temporal_style.cview() : p.style.cview(),
@@ -218,6 +222,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
       warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor_nnf);
       params.initial_nnf = warm.cview();
+      params.warm_sharp_estimate = p.sharpening.sharp_estimate;
       warm_schedule(l.synth, l.temporal, params);
     }
   }
@@ -279,7 +284,8 @@ class ShotRun {
     resolve_range(shot, o, a_, b_);
     selected_ = selected_layers(shot, o.layers);
     for (const Layer* l : selected_)
-      prepared_.push_back(prepare(*l, exemplars.at(l->exemplar), maps));
+      prepared_.push_back(
+          prepare(*l, exemplars.at(l->exemplar), maps, shot.source.width, shot.source.height));
     first_ = o.chain_from < 0 ? shot.source.first_frame
                               : std::clamp(o.chain_from, shot.source.first_frame, a_);
   }
@@ -513,8 +519,8 @@ RunReport run_shot(const Shot& shot, const FrameSource& frames,
 Image<float> synthesize_alone(const Layer& layer, const ExemplarImages& exemplar,
                               ImageView<const float> passes, int frame,
                               const WeightMapImages& weight_maps) {
-  return synthesize_layer(prepare(layer, exemplar, weight_maps), passes, frame, nullptr, nullptr,
-                          {}, nullptr)
+  return synthesize_layer(prepare(layer, exemplar, weight_maps, passes.width, passes.height),
+                          passes, frame, nullptr, nullptr, {}, nullptr)
       .value;
 }
 

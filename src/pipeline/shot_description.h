@@ -147,7 +147,11 @@ struct TemporalSpec {
   // Both sides of the temporal guide — the exemplar A' and B'adv — low-passed by a Gaussian of
   // this sigma in pixels (0: none): voting and resampling soften B'adv, and matching it against
   // a sharp A' favours the exemplar's flattest patches, so the chain fades frame by frame.
-  float guide_sigma = 0.0f;
+  // Negative: from the frame's size against the painting's (temporal_sharpening()).
+  float guide_sigma = -1.0f;
+  // The warm start's first estimate: synth::Params::warm_sharp_estimate. Negative: from the
+  // frame's size against the painting's (temporal_sharpening()).
+  float sharp_estimate = -1.0f;
   // A warm start drops the carried field where the temporal guide has no confidence (surface
   // hidden at t-1, the layer's guides changed): those pixels are searched afresh.
   bool reseed = false;

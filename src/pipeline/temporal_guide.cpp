@@ -23,6 +23,16 @@ uint64_t frame_seed(const Layer& l, int frame, int transfer) {
   return hash_key(l.synth.seed, uint64_t(frame), uint64_t(transfer));
 }
 
+TemporalSharpening temporal_sharpening(const TemporalSpec& t, int frame_width, int frame_height,
+                                       int painting_width, int painting_height) {
+  const double painting = double(painting_width) * painting_height;
+  const double share = painting > 0.0 ? double(frame_width) * frame_height / painting : 0.0;
+  const float k =
+      t.weight > 0.0f ? float(std::clamp((share - 0.12) / (0.40 - 0.12), 0.0, 1.0)) : 0.0f;
+  return {t.guide_sigma >= 0.0f ? t.guide_sigma : k,
+          t.sharp_estimate >= 0.0f ? t.sharp_estimate : k};
+}
+
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
   if (const temporal::AdvectionField* f = find(l, frame)) return *f;

@@ -23,6 +23,20 @@ synth::Params synth_params(const SynthSpec& s, uint64_t seed);
 // run draws exactly the numbers an uninterrupted one would.
 uint64_t frame_seed(const Layer& l, int frame, int transfer);
 
+// What a temporal layer's chain does against the blur that carrying it adds frame after frame:
+// its temporal guide's low-pass (TemporalSpec::guide_sigma) and the warm start's first estimate
+// (synth::Params::warm_sharp_estimate). A key set in the spec (>= 0) is taken as it is; unset,
+// both come from how many pixels the frame has against the painting: none up to 12 % of the
+// painting's, all (sigma 1 pixel, the estimate each pixel's own match) from 40 %, linear
+// between, and none for a layer without a temporal guide (weight 0). The chain loses the
+// painting's grain with that share, not with the frame's size (docs/design/long-shots.md).
+struct TemporalSharpening {
+  float guide_sigma = 0.0f;
+  float sharp_estimate = 0.0f;
+};
+TemporalSharpening temporal_sharpening(const TemporalSpec& t, int frame_width, int frame_height,
+                                       int painting_width, int painting_height);
+
 // One frame's advection fields, shared by the layers that advect with the same guide, patch size
 // and seed: a field depends on neither a layer's value nor its mask (temporal::advection_field),
 // so the layers of a shot, which differ in those, match once per frame instead of once each.

@@ -172,11 +172,11 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
                   c.error_full, c.error_none, c.foreign_none, c.erode, layer.temporal.uniformity));
   const pipeline::TemporalSpec& t = layer.temporal;
   l.add(p + "temporal.chain",
-        fmt::format("guide_sigma {} reseed {} change {} {} anchor {} sigma {} rate {} holes {} "
-                    "finest {} schedule {} {}",
-                    t.guide_sigma, t.reseed, c.change_full, c.change_none, t.anchor, t.anchor_sigma,
-                    t.anchor_rate, t.anchor_holes, t.anchor_finest_iters, t.finest_iters,
-                    t.warm_patch_match_iters));
+        fmt::format("guide_sigma {} sharp {} reseed {} change {} {} anchor {} sigma {} rate {} "
+                    "holes {} finest {} schedule {} {}",
+                    t.guide_sigma, t.sharp_estimate, t.reseed, c.change_full, c.change_none,
+                    t.anchor, t.anchor_sigma, t.anchor_rate, t.anchor_holes, t.anchor_finest_iters,
+                    t.finest_iters, t.warm_patch_match_iters));
   l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
                                 layer.mask.dilate, layer.mask.threshold));
   return l.m;

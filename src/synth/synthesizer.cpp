@@ -275,7 +275,31 @@ struct Solve {
     err.reset(L.tw, L.th, 1);
     if (!L.weight_maps.empty()) L.group_weights = quantize_group_weights(L.weight_maps);
     vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
+    if (coarsest && l == 0 && !params.initial_nnf.empty() && params.warm_sharp_estimate > 0.0f)
+      sharpen_estimate(source_style(L, l), L);
     write_style(style, layout, L.tgt, border);
+  }
+
+  // Mixes each pixel's own match's centre value into the voted estimate
+  // (Params::warm_sharp_estimate).
+  void sharpen_estimate(const Plane& source, const Level& L) {
+    const int ns = layout.style_channels;
+    Image<float> values(L.sw, L.sh, ns);
+    parallel_rows(L.sh, 32, [&](int y0, int y1) {
+      for_each_row(source, y0, y1, [&](int y, const float* row) {
+        std::copy(row, row + std::size_t(L.sw) * ns, values.at(0, y));
+      });
+    });
+    const float a = std::min(params.warm_sharp_estimate, 1.0f);
+    parallel_rows(L.th, 32, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < L.tw; ++x) {
+          if (!L.active.empty() && !L.active(x, y)) continue;
+          const float* c = values.at(nnf(x, y, 0), nnf(x, y, 1));
+          float* s = style.at(x, y);
+          for (int k = 0; k < ns; ++k) s[k] += a * (c[k] - s[k]);
+        }
+    });
   }
 
   // The schedule's search-vote iterations at one level; `step` seeds them. `last`: the pass

@@ -100,6 +100,11 @@ struct Params {
   // leaves the source (such as Result::nnf's (-1, -1) outside a mask) starts at a random draw
   // keyed by `seed` and the pixel, as FieldInit::kRandom would.
   ImageView<const int32_t> initial_nnf = {};
+  // A warm start's first estimate of the target style, which the first search compares the
+  // exemplar's patches with: 0 votes the given field (as every level does); 1 takes each pixel's
+  // own match's centre value, sharp where the vote of a carried field that has come apart
+  // blurs; between, that mix. Without a warm start it does nothing.
+  float warm_sharp_estimate = 0.0f;
   bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
   VoteMode vote_mode = VoteMode::kWeighted;
   uint64_t seed = 1;

@@ -185,6 +185,49 @@ TEST(Synthesize, WarmStartFromAGivenField) {
   }
 }
 
+// With no search the output is the warm start's first estimate: the vote of the given field,
+// each pixel's own match's centre value (warm_sharp_estimate 1), or the mix between.
+TEST(Synthesize, WarmSharpEstimateTakesEachPixelsOwnMatch) {
+  Fixture f;
+  f.style = noise(64, 48, 1, 4);
+  f.guide_src = textured(64, 48, 5);
+  f.guide_tgt = textured(72, 40, 6);
+  OutputRequest req;
+  req.nnf = true;
+  const Result cold = synthesize(f.inputs(), Params{}, req);
+  Params warm;
+  warm.initial_nnf = cold.nnf.cview();
+  warm.finest_search_vote_iters = 0;
+  const Result voted = synthesize(f.inputs(), warm, req);
+  warm.warm_sharp_estimate = 1.0f;
+  const Result sharp = synthesize(f.inputs(), warm, req);
+  warm.warm_sharp_estimate = 0.25f;
+  const Result mixed = synthesize(f.inputs(), warm, req);
+  int differ = 0;
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 72; ++x) {
+      const float own = f.style(cold.nnf(x, y, 0), cold.nnf(x, y, 1));
+      ASSERT_EQ(sharp.image(x, y), own) << x << ", " << y;
+      const float v = voted.image(x, y);
+      EXPECT_NEAR(mixed.image(x, y), v + 0.25f * (own - v), 1e-5f) << x << ", " << y;
+      differ += v != own;
+    }
+  EXPECT_GT(differ, 72 * 40 / 2);  // the vote blurs what the centres keep
+
+  Params cold_params;
+  cold_params.warm_sharp_estimate = 1.0f;  // no warm start: nothing changes
+  EXPECT_TRUE(same_bits(synthesize(f.inputs(), cold_params).image, cold.image));
+  for (float bad : {-0.5f, 1.5f, std::numeric_limits<float>::quiet_NaN()}) {
+    warm.warm_sharp_estimate = bad;
+    try {
+      synthesize(f.inputs(), warm);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.field(), "warm_sharp_estimate");
+    }
+  }
+}
+
 TEST(Synthesize, SeedChangesTheResult) {
   Fixture f;
   f.style = noise(64, 48, 1, 4);

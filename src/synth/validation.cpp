@@ -35,6 +35,8 @@ void validate(const Inputs& in, const Params& p) {
   if (p.patch_match_iters < -1) throw Error(F{"patch_match_iters"}, "must be >= 0");
   if (p.search_radius < 0) throw Error(F{"search_radius"}, "must be >= 0 (0: the whole exemplar)");
   if (!std::isfinite(p.style_weight)) throw Error(F{"style_weight"}, "must be finite");
+  if (!(p.warm_sharp_estimate >= 0.0f && p.warm_sharp_estimate <= 1.0f))
+    throw Error(F{"warm_sharp_estimate"}, "must be between 0 and 1");
   if (p.finest_search_vote_iters < -1) throw Error(F{"finest_search_vote_iters"}, "must be >= 0");
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
