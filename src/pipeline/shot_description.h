@@ -150,8 +150,10 @@ struct TemporalSpec {
   // Negative: from the frame's size against the painting's (temporal_sharpening()).
   float guide_sigma = -1.0f;
   // The warm start's first estimate: synth::Params::warm_sharp_estimate. Negative: from the
-  // frame's size against the painting's (temporal_sharpening()).
-  float sharp_estimate = -1.0f;
+  // frame's size against the painting's (temporal_sharpening()). Off by default: it keeps more
+  // grain but flickers more and breaks the hatching's strokes up
+  // (docs/design/temporal-sharpening.md).
+  float sharp_estimate = 0.0f;
   // A warm start drops the carried field where the temporal guide has no confidence (surface
   // hidden at t-1, the layer's guides changed): those pixels are searched afresh.
   bool reseed = false;

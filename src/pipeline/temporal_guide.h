@@ -25,11 +25,12 @@ uint64_t frame_seed(const Layer& l, int frame, int transfer);
 
 // What a temporal layer's chain does against the blur that carrying it adds frame after frame:
 // its temporal guide's low-pass (TemporalSpec::guide_sigma) and the warm start's first estimate
-// (synth::Params::warm_sharp_estimate). A key set in the spec (>= 0) is taken as it is; unset,
-// both come from how many pixels the frame has against the painting: none up to 12 % of the
-// painting's, all (sigma 1 pixel, the estimate each pixel's own match) from 40 %, linear
-// between, and none for a layer without a temporal guide (weight 0). The chain loses the
-// painting's grain with that share, not with the frame's size (docs/design/long-shots.md).
+// (synth::Params::warm_sharp_estimate). A value set in the spec (>= 0) is taken as it is (the
+// estimate's default is 0); negative, it comes from how many pixels the frame has against the
+// painting: none up to 12 % of the painting's, all (sigma 1 pixel, the estimate each pixel's
+// own match) from 40 %, linear between, and none for a layer without a temporal guide
+// (weight 0). The chain loses the painting's grain with that share, not with the frame's size
+// (docs/design/long-shots.md).
 struct TemporalSharpening {
   float guide_sigma = 0.0f;
   float sharp_estimate = 0.0f;

@@ -8,7 +8,9 @@ namespace emaki::pipeline {
 namespace {
 
 TEST(TemporalSharpening, FollowsTheFramesShareOfThePaintingsPixels) {
-  const TemporalSpec t;
+  TemporalSpec t;
+  EXPECT_EQ(temporal_sharpening(t, 960, 540, 1200, 912).sharp_estimate, 0.0f);  // off by default
+  t.sharp_estimate = -1.0f;
   // The StyLit painting (1200x912) under the Fox example's sizes and the town's.
   TemporalSharpening s = temporal_sharpening(t, 480, 270, 1200, 912);
   EXPECT_EQ(s.guide_sigma, 0.0f);
