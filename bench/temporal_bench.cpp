@@ -262,8 +262,9 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
   }
 }
 
-// The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma), x=X (the warm start's
-// sharp estimate; s and x unset: from the frame's size against the painting's), u=U (temporal
+// The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma; unset: from the frame's
+// size against the painting's), x=X (the warm start's sharp estimate; unset: 0, -1: from that
+// size as the sigma), u=U (temporal
 // uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));

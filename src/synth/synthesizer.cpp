@@ -275,7 +275,8 @@ struct Solve {
     err.reset(L.tw, L.th, 1);
     if (!L.weight_maps.empty()) L.group_weights = quantize_group_weights(L.weight_maps);
     vote(source_style(L, l), nnf, err, L.active, p, VoteMode::kPlain, style);
-    if (coarsest && l == 0 && !params.initial_nnf.empty() && params.warm_sharp_estimate > 0.0f)
+    // A warm start runs the finest level alone, so this is its first estimate.
+    if (!params.initial_nnf.empty() && params.warm_sharp_estimate > 0.0f)
       sharpen_estimate(source_style(L, l), L);
     write_style(style, layout, L.tgt, border);
   }
@@ -290,7 +291,7 @@ struct Solve {
         std::copy(row, row + std::size_t(L.sw) * ns, values.at(0, y));
       });
     });
-    const float a = std::min(params.warm_sharp_estimate, 1.0f);
+    const float a = params.warm_sharp_estimate;  // in (0, 1] (validate())
     parallel_rows(L.th, 32, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)
         for (int x = 0; x < L.tw; ++x) {
