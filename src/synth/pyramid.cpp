@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/parallel.h"
 
@@ -13,28 +14,36 @@ template <typename T>
 Image<T> downsample_impl(ImageView<const T> in) {
   const int w = in.width, h = in.height, c = in.channels;
   const int ow = half_size(w), oh = half_size(h);
-  // Horizontal pass into float, then vertical pass.
-  Image<float> tmp(ow, h, c);
-  parallel_rows(h, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
+  Image<T> out(ow, oh, c);
+  // Each band of output rows: the horizontal pass of the input rows it reads, into floats the
+  // band alone holds (a whole-image float buffer was twice the output of an int16 level, the
+  // synthesis's peak of memory), then the vertical pass. The rows two bands share are filtered
+  // by both, the same way: the result does not depend on the bands.
+  parallel_rows(oh, 32, [&](int y0, int y1) {
+    const int r0 = std::clamp(2 * y0 - 1, 0, h - 1), r1 = std::min(2 * (y1 - 1) + 2, h - 1);
+    const std::size_t row = std::size_t(ow) * c;
+    std::vector<float> tmp(std::size_t(r1 - r0 + 1) * row);
+    for (int y = r0; y <= r1; ++y) {
+      float* t = tmp.data() + std::size_t(y - r0) * row;
       for (int x = 0; x < ow; ++x) {
         const int xs[4] = {std::clamp(2 * x - 1, 0, w - 1), std::min(2 * x, w - 1),
                            std::min(2 * x + 1, w - 1), std::min(2 * x + 2, w - 1)};
         for (int k = 0; k < c; ++k)
-          tmp(x, y, k) = (float(in(xs[0], y, k)) + 3.0f * float(in(xs[1], y, k)) +
-                          3.0f * float(in(xs[2], y, k)) + float(in(xs[3], y, k))) *
-                         0.125f;
+          t[std::size_t(x) * c + k] = (float(in(xs[0], y, k)) + 3.0f * float(in(xs[1], y, k)) +
+                                       3.0f * float(in(xs[2], y, k)) + float(in(xs[3], y, k))) *
+                                      0.125f;
       }
-  });
-  Image<T> out(ow, oh, c);
-  parallel_rows(oh, 32, [&](int y0, int y1) {
+    }
+    auto at = [&](int x, int y, int k) {
+      return tmp[std::size_t(y - r0) * row + std::size_t(x) * c + k];
+    };
     for (int y = y0; y < y1; ++y) {
       const int ys[4] = {std::clamp(2 * y - 1, 0, h - 1), std::min(2 * y, h - 1),
                          std::min(2 * y + 1, h - 1), std::min(2 * y + 2, h - 1)};
       for (int x = 0; x < ow; ++x)
         for (int k = 0; k < c; ++k) {
-          const float v = (tmp(x, ys[0], k) + 3.0f * tmp(x, ys[1], k) + 3.0f * tmp(x, ys[2], k) +
-                           tmp(x, ys[3], k)) *
+          const float v = (at(x, ys[0], k) + 3.0f * at(x, ys[1], k) + 3.0f * at(x, ys[2], k) +
+                           at(x, ys[3], k)) *
                           0.125f;
           if constexpr (std::is_integral_v<T>)
             out(x, y, k) = T(std::lround(v));
