@@ -265,7 +265,8 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma; unset: from the frame's
 // size against the painting's), x=X (the warm start's sharp estimate; unset: 0, -1: from that
 // size as the sigma), u=U (temporal
-// uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed).
+// uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed),
+// im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
   for (std::string m; std::getline(ss, m, ':');) {
@@ -294,6 +295,10 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.anchor_sigma = x;
     } else if (key == "ah") {
       l.temporal.anchor_holes = x != 0.0f;
+    } else if (key == "im") {
+      l.temporal.ink_match = x;
+    } else if (key == "is") {
+      l.temporal.ink_sigma = x;
     } else if (key == "ar") {
       l.temporal.anchor_rate = x;
     } else if (key == "e") {

@@ -121,32 +121,15 @@ void add_temporal_guide(const PreparedLayer& p, ImageView<const float> passes,
   inputs.guides.push_back(pair);
 }
 
-// The warm start's field: the previous field carried along the frame's advection field, with
-// the entries dropped (drawn afresh) where the temporal guide has no confidence (reseed).
-// Where the temporal guide has no confidence, the tone anchor's fresh field (`fresh`, when not
-// empty) takes their place instead.
-Image<int32_t> warm_field(const Layer& l, ImageView<const int32_t> previous_nnf,
-                          const temporal::AdvectionField& field, const Image<float>& confidence,
-                          const Image<int32_t>& fresh) {
-  Image<int32_t> warm = carry_field(previous_nnf, field);
-  if ((!l.temporal.reseed && fresh.empty()) || warm.empty() || confidence.empty()) return warm;
-  for (int y = 0; y < warm.height(); ++y)
-    for (int x = 0; x < warm.width(); ++x)
-      if (confidence(x, y) <= 0.0f) {
-        warm(x, y, 0) = fresh.empty() ? -1 : fresh(x, y, 0);
-        warm(x, y, 1) = fresh.empty() ? -1 : fresh(x, y, 1);
-      }
-  return warm;
-}
-
 // The tone anchor at a temporal frame (TemporalSpec::anchor, pipeline/tone_anchor.h): with a
-// temporal guide, its target B'adv anchored to a fresh transfer's tone; returns the fresh
-// transfer's field for the warm start's holes (TemporalSpec::anchor_holes), or an empty field.
-Image<int32_t> anchor_layer(const PreparedLayer& p, int frame, const synth::Params& params,
-                            const Image<float>& mask, TemporalPair& t, synth::Inputs& inputs) {
+// temporal guide, its target B'adv anchored to a fresh transfer's tone (moved out of the result).
+Anchor anchor_layer(const PreparedLayer& p, int frame, const synth::Params& params,
+                    const Image<float>& mask, TemporalPair& t, synth::Inputs& inputs) {
   const Layer& l = *p.layer;
   const bool guide = l.temporal.weight > 0.0f;
-  if (l.temporal.anchor <= 0 || (!guide && !l.temporal.anchor_holes)) return {};
+  if (l.temporal.anchor <= 0 ||
+      (!guide && !l.temporal.anchor_holes && l.temporal.ink_match <= 0.0f))
+    return {};
   synth::Inputs fresh = inputs;
   fresh.guides.pop_back();  // the temporal pair
   synth::Params fresh_params = params;
@@ -158,7 +141,8 @@ Image<int32_t> anchor_layer(const PreparedLayer& p, int frame, const synth::Para
     t.target = std::move(a.target);
     inputs.guides.back().target = synth::Plane(t.target.cview());
   }
-  return l.temporal.anchor_holes ? std::move(a.nnf) : Image<int32_t>{};
+  if (!l.temporal.anchor_holes) a.nnf = {};
+  return a;
 }
 
 // One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
@@ -207,9 +191,9 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   if (!mask.empty()) inputs.target_mask = mask.cview();
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
   if (o) params.cancel = o->cancel;
-  const Image<int32_t> anchor_nnf =
-      advected.value.empty() ? Image<int32_t>{}
-                             : anchor_layer(p, frame, params, mask, temporal_pair, inputs);
+  const Anchor anchor = advected.value.empty()
+                            ? Anchor{}
+                            : anchor_layer(p, frame, params, mask, temporal_pair, inputs);
   // With a temporal guide, B'adv already carries the previous frame's converged texture: one
   // search-vote iteration at the finest level instead of two keeps flicker and the judge's
   // style energy within their bars (measured on the example, docs/design/advection.md) and saves
@@ -220,7 +204,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     params.uniformity = l.temporal.uniformity;
     const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
-      warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor_nnf);
+      warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor.nnf);
       params.initial_nnf = warm.cview();
       params.warm_sharp_estimate = p.sharpening.sharp_estimate;
       warm_schedule(l.synth, l.temporal, params);
@@ -230,6 +214,8 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   request.nnf = l.temporal.enabled && l.temporal.warm_start;
   request.error = o && o->error_maps;  // measured once the result is made: it does not change it
   synth::Result r = synth::synthesize(inputs, params, request);
+  match_ink(r.image, n, anchor, mask, advected.confidence, l.temporal.ink_sigma,
+            l.temporal.ink_match);
   return {std::move(r.image), std::move(r.nnf), std::move(r.error)};
 }
 

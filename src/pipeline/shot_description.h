@@ -171,6 +171,11 @@ struct TemporalSpec {
   // Search-vote iterations at the fresh transfer's finest level (-1: the schedule's).
   int anchor_finest_iters = -1;
   bool anchor_holes = true;
+  // The share of the way the result's ink moves to the fresh transfer's in its low
+  // frequencies (a Gaussian of ink_sigma pixels at the fresh transfer's size; match_ink()), after
+  // the main transfer; 0: off.
+  float ink_match = 0.0f;
+  float ink_sigma = 4.0f;
   // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
   // iterations in each.
   int finest_iters = 1;

@@ -63,6 +63,20 @@ Image<int32_t> carry_field(ImageView<const int32_t> previous, const temporal::Ad
   return out;
 }
 
+Image<int32_t> warm_field(const Layer& l, ImageView<const int32_t> previous,
+                          const temporal::AdvectionField& field, const Image<float>& confidence,
+                          const Image<int32_t>& fresh) {
+  Image<int32_t> warm = carry_field(previous, field);
+  if ((!l.temporal.reseed && fresh.empty()) || warm.empty() || confidence.empty()) return warm;
+  for (int y = 0; y < warm.height(); ++y)
+    for (int x = 0; x < warm.width(); ++x)
+      if (confidence(x, y) <= 0.0f) {
+        warm(x, y, 0) = fresh.empty() ? -1 : fresh(x, y, 0);
+        warm(x, y, 1) = fresh.empty() ? -1 : fresh(x, y, 1);
+      }
+  return warm;
+}
+
 namespace {
 
 // The layer's guides whose change along the advection means the painting's answer changed: all

@@ -76,4 +76,11 @@ temporal::Advection advect_layer(const Layer& layer, ImageView<const float> pass
 Image<int32_t> carry_field(ImageView<const int32_t> previous,
                            const temporal::AdvectionField& field);
 
+// carry_field() with the entries dropped where the temporal guide has no `confidence`: drawn
+// afresh (TemporalSpec::reseed), or, when `fresh` (the tone anchor's field at full size) is not
+// empty, taken from it.
+Image<int32_t> warm_field(const Layer& layer, ImageView<const int32_t> previous,
+                          const temporal::AdvectionField& field, const Image<float>& confidence,
+                          const Image<int32_t>& fresh);
+
 }  // namespace emaki::pipeline

@@ -129,6 +129,9 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
       diff.cview(), sigma, small_mask.empty() ? ImageView<const float>{} : small_mask.cview());
 
   Anchor a;
+  a.fresh = extract(fresh.image.cview(), 0, n);
+  a.small_mask = std::move(small_mask);
+  a.halvings = halvings;
   Image<float>& out = a.target;
   out.reset(advected.width, advected.height, n);
   a.nnf = spread_field(fresh.nnf, advected.width, advected.height, halvings);
@@ -141,6 +144,49 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
         out(x, y, c) = std::clamp(advected(x, y, c) + d, 0.0f, 1.0f);
       }
   return a;
+}
+
+void match_ink(Image<float>& layer, int value_channels, const Anchor& a, const Image<float>& mask,
+               const Image<float>& confidence, float sigma, float share) {
+  if (a.fresh.empty() || share <= 0.0f) return;
+  const int n = value_channels;
+  // Ink below this floor counts as bare paper on both sides: the scale stays near 1 there.
+  constexpr float kFloor = 0.02f;
+  const Image<float> small = halve(extract(layer.cview(), 0, n), a.halvings);
+  const int sw = small.width(), sh = small.height();
+  CHECK_EQ(a.fresh.width(), sw);
+  CHECK_EQ(a.fresh.height(), sh);
+  Image<float> ink_fresh(sw, sh, n), ink_chain(sw, sh, n);
+  for (int y = 0; y < sh; ++y)
+    for (int x = 0; x < sw; ++x)
+      for (int c = 0; c < n; ++c) {
+        ink_fresh(x, y, c) = 1.0f - a.fresh(x, y, c);
+        ink_chain(x, y, c) = 1.0f - small(x, y, c);
+      }
+  const ImageView<const float> m =
+      a.small_mask.empty() ? ImageView<const float>{} : a.small_mask.cview();
+  const Image<float> lf = temporal::low_pass(ink_fresh.cview(), sigma, m);
+  const Image<float> lc = temporal::low_pass(ink_chain.cview(), sigma, m);
+  Image<float> scale(sw, sh, n);
+  for (int y = 0; y < sh; ++y)
+    for (int x = 0; x < sw; ++x)
+      for (int c = 0; c < n; ++c) {
+        const float r = std::clamp((lf(x, y, c) + kFloor) / (lc(x, y, c) + kFloor), 0.5f, 2.0f);
+        scale(x, y, c) = 1.0f + share * (r - 1.0f);
+      }
+  const int w = layer.width(), h = layer.height();
+  const float fx = float(sw) / float(w), fy = float(sh) / float(h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (!mask.empty() && mask(x, y) <= 0.5f) continue;
+      const float trust = confidence.empty() ? 1.0f : std::clamp(confidence(x, y), 0.0f, 1.0f);
+      for (int c = 0; c < n; ++c) {
+        const float k = 1.0f + trust * (sample(scale, (float(x) + 0.5f) * fx - 0.5f,
+                                               (float(y) + 0.5f) * fy - 0.5f, c) -
+                                        1.0f);
+        layer(x, y, c) = std::clamp(1.0f - k * (1.0f - layer(x, y, c)), 0.0f, 1.0f);
+      }
+    }
 }
 
 }  // namespace emaki::pipeline

@@ -73,5 +73,73 @@ TEST(ToneAnchor, IsTheSameForTheSameInputs) {
     }
 }
 
+// Strokes of ink 0.4 (value 0.6) on bare paper, every fourth column; the fresh transfer at half
+// size says the frame holds twice that ink. Away from the borders (where the halving clamps):
+TEST(MatchInk, ScalesTheInkToTheFreshTransfersAndKeepsTheStrokesShape) {
+  const int w = 64, h = 32;
+  Image<float> layer(w, h, 2);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      layer(x, y, 0) = x % 4 == 0 ? 0.6f : 1.0f;
+      layer(x, y, 1) = 1.0f;  // coverage: untouched
+    }
+  // The layer's ink is 0.1 a pixel: the fresh transfer holds 0.2.
+  Anchor a;
+  a.halvings = 1;
+  a.fresh.reset(w / 2, h / 2, 1);
+  for (int y = 0; y < h / 2; ++y)
+    for (int x = 0; x < w / 2; ++x) a.fresh(x, y) = 0.8f;
+  const Image<float> before = layer.clone();
+  Image<float> probe = layer.clone();
+  match_ink(probe, 1, a, {}, {}, 2.0f, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) ASSERT_EQ(probe(x, y, 0), before(x, y, 0)) << "share 0";
+  Image<float> half = layer.clone();
+  match_ink(layer, 1, a, {}, {}, 2.0f, 1.0f);
+  match_ink(half, 1, a, {}, {}, 2.0f, 0.5f);
+  // (0.2 + floor) / (0.1 + floor) with the floor 0.02: 1.83 times the ink; half the way, 1.42.
+  const double full_scale = 0.22 / 0.12, half_scale = 1.0 + (full_scale - 1.0) / 2.0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      EXPECT_EQ(layer(x, y, 1), 1.0f);
+      if (x % 4 != 0) {
+        ASSERT_EQ(layer(x, y, 0), 1.0f) << "bare paper stays bare at " << x << "," << y;
+      } else if (x >= 16 && x < 48 && y >= 8 && y < 24) {
+        EXPECT_NEAR(1.0 - layer(x, y, 0), 0.4 * full_scale, 0.02) << x << "," << y;
+        EXPECT_NEAR(1.0 - half(x, y, 0), 0.4 * half_scale, 0.02) << x << "," << y;
+      }
+    }
+}
+
+TEST(MatchInk, ChangesNothingOutsideTheMaskOrWithoutAFreshTransfer) {
+  Image<float> layer(16, 16, 1);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) layer(x, y) = (x + y) % 3 ? 0.9f : 0.5f;
+  const Image<float> before = layer.clone();
+  match_ink(layer, 1, Anchor{}, {}, {}, 2.0f, 1.0f);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) ASSERT_EQ(layer(x, y), before(x, y));
+  Anchor a;
+  a.halvings = 1;
+  a.fresh.reset(8, 8, 1);  // all ink: the scale is held at 2
+  Image<float> mask(16, 16, 1);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) mask(x, y) = x < 8 ? 1.0f : 0.0f;
+  // No confidence on the first row: a pixel the chain did not carry is left as it is.
+  Image<float> confidence(16, 16, 1);
+  for (int y = 1; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) confidence(x, y) = 1.0f;
+  match_ink(layer, 1, a, mask, confidence, 2.0f, 1.0f);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      if (x >= 8 || y == 0) {
+        ASSERT_EQ(layer(x, y), before(x, y))
+            << "outside the mask or not carried at " << x << "," << y;
+      } else {
+        EXPECT_NEAR(1.0f - layer(x, y), 2.0f * (1.0f - before(x, y)), 1e-5f);
+      }
+    }
+}
+
 }  // namespace
 }  // namespace emaki::pipeline
