@@ -19,6 +19,10 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // lightened it frame by frame (docs/design/temporal-default.md).
       d.temporal_weight = 0.0f;
       d.temporal_uniformity = 0.0f;
+      // Uncovered pixels start from a fresh transfer at half size, not a quarter: at a quarter
+      // the shadow's edge blurs, and where a moving light uncovered ground the layer came out
+      // 13 levels of 255 lighter than frame by frame (docs/design/long-shots.md).
+      d.temporal_anchor = 1;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};

@@ -104,6 +104,8 @@ struct KindDefaults {
   composite::LayerLook look;
   float temporal_weight = 1.0f;
   float temporal_uniformity = 1000.0f;
+  // The tone anchor's halvings (pipeline::TemporalSpec::anchor; not a shot-file key).
+  int temporal_anchor = 2;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);
