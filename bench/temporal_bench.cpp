@@ -36,6 +36,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -231,6 +232,7 @@ struct Variant {
   int drift_frames = 0;
   bench::ToneTexture tone;  // inside the mask, over the last quarter
   bench::ToneTexture wash;  // in recently disoccluded pixels inside the mask, every frame
+  std::map<int, bench::ToneTexture> tone_by_id;  // `tone` per object id
 };
 
 double mean_value(const Image<float>& v) {
@@ -241,22 +243,46 @@ double mean_value(const Image<float>& v) {
   return sum / (double(v.width()) * v.height() * v.channels());
 }
 
-// Flicker per object id (rows) and variant (columns), and each variant against the first.
+std::string object_name(const pipeline::Shot& shot, int id) {
+  std::string name = id == 1 ? "ground" : "object";
+  for (std::size_t i = 0; i < shot.source.objects.size(); ++i)
+    if (shot.source.objects[i].id == id)
+      name = fmt::format("objects[{}] {}", i,
+                         std::filesystem::path(shot.source.objects[i].scene).stem().string());
+  return name;
+}
+
+// Flicker per object id (rows) and variant (columns), and each variant against the first; then
+// each temporal variant's tone drift and texture kept per object (as print_tone_table's).
 void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& variants) {
   std::printf("\n%-4s %-24s", "id", "object");
   for (const Variant& v : variants) std::printf(" %14s", v.name.c_str());
   std::printf("\n");
   for (const auto& [id, first] : variants[0].flicker.by_id) {
-    std::string name = id == 1 ? "ground" : "object";
-    for (std::size_t i = 0; i < shot.source.objects.size(); ++i)
-      if (shot.source.objects[i].id == id)
-        name = fmt::format("objects[{}] {}", i,
-                           std::filesystem::path(shot.source.objects[i].scene).stem().string());
-    std::printf("%-4d %-24s", id, name.c_str());
+    std::printf("%-4d %-24s", id, object_name(shot, id).c_str());
     for (const Variant& v : variants) {
       const auto it = v.flicker.by_id.find(id);
       const double m = it == v.flicker.by_id.end() ? 0.0 : it->second.mean();
       std::printf(" %7.5f %5.2fx", m, first.mean() > 0 ? m / first.mean() : 0.0);
+    }
+    std::printf("\n");
+  }
+  std::printf("\n%-4s %-24s", "id", "tone, texture");
+  for (const Variant& v : variants)
+    if (!v.tone_by_id.empty()) std::printf(" %16s", v.name.c_str());
+  std::printf("\n");
+  std::map<int, long> ids;
+  for (const Variant& v : variants)
+    for (const auto& [id, t] : v.tone_by_id) ids[id] += t.pixels;
+  for (const auto& [id, pixels] : ids) {
+    std::printf("%-4d %-24s", id, object_name(shot, id).c_str());
+    for (const Variant& v : variants) {
+      if (v.tone_by_id.empty()) continue;
+      const auto it = v.tone_by_id.find(id);
+      if (it == v.tone_by_id.end())
+        std::printf(" %16s", "-");
+      else
+        std::printf(" %+7.2f %7.3fx", it->second.drift_levels(), it->second.texture_kept());
     }
     std::printf("\n");
   }
@@ -433,6 +459,8 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
       v.drift_sum += mean_value(cur_white) - mean_value(ref_white);
       ++v.drift_frames;
       bench::add_tone_texture(v.tone, cur_white, ref_white, cur, mask_channel, {});
+      bench::add_tone_texture_by_object(v.tone_by_id, cur_white, ref_white, cur, mask_channel,
+                                        passes.cview());
     }
   }
   if (!opt.save.empty())

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 
 #include "core/image.h"
 #include "pipeline/frames.h"
@@ -64,6 +65,24 @@ inline void add_tone_texture(ToneTexture& t, const Image<float>& value,
     for (int x = 0; x < value.width(); ++x) {
       if (mask_channel >= 0 && raw(x, y, mask_channel) < 0.5f) continue;
       if (!select.empty() && !select(x, y)) continue;
+      t.level_sum += value(x, y, 0), t.reference_level_sum += reference(x, y, 0);
+      t.energy += double(hv(x, y)) * hv(x, y), t.reference_energy += double(hr(x, y)) * hr(x, y);
+      ++t.pixels;
+    }
+}
+
+// add_tone_texture() per object: each pixel inside the mask counts for the object id its passes
+// give it (1: the ground; the background, alpha 0, is left out).
+inline void add_tone_texture_by_object(std::map<int, ToneTexture>& by_id, const Image<float>& value,
+                                       const Image<float>& reference, const Image<float>& raw,
+                                       int mask_channel, ImageView<const float> passes) {
+  const Image<float> hv = high_pass(value), hr = high_pass(reference);
+  for (int y = 0; y < value.height(); ++y)
+    for (int x = 0; x < value.width(); ++x) {
+      if (mask_channel >= 0 && raw(x, y, mask_channel) < 0.5f) continue;
+      const float* p = passes.at(x, y);
+      if (p[render::kAlpha] <= 0.5f) continue;
+      ToneTexture& t = by_id[int(std::lround(p[render::kObjectId]))];
       t.level_sum += value(x, y, 0), t.reference_level_sum += reference(x, y, 0);
       t.energy += double(hv(x, y)) * hv(x, y), t.reference_energy += double(hr(x, y)) * hr(x, y);
       ++t.pixels;
