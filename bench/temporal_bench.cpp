@@ -226,6 +226,7 @@ struct Variant {
   bench::MemoryStore store;
   double seconds = 0.0;
   pipeline::SequenceFlicker flicker;
+  pipeline::SequenceFlicker held_flicker;  // where the light held (bench::light_held)
   pipeline::GhostStats ghost;
   double style_sum = 0.0, coverage_sum = 0.0;
   double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
@@ -234,6 +235,9 @@ struct Variant {
   bench::ToneTexture wash;  // in recently disoccluded pixels inside the mask, every frame
   std::map<int, bench::ToneTexture> tone_by_id;  // `tone` per object id
 };
+
+// A guide value that moves by no more than this between frames counts as the same light.
+constexpr float kLightTolerance = 0.02f;
 
 double mean_value(const Image<float>& v) {
   double sum = 0.0;
@@ -267,15 +271,22 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
     }
     std::printf("\n");
   }
-  std::printf("\n%-4s %-24s", "id", "tone, texture");
+  // Pixels: the object's share of the layer's pixels in the last quarter (each variant counts
+  // the same ones).
+  std::printf("\n%-4s %-24s %7s", "id", "tone, texture", "pixels");
   for (const Variant& v : variants)
     if (!v.tone_by_id.empty()) std::printf(" %16s", v.name.c_str());
   std::printf("\n");
   std::map<int, long> ids;
+  long all = 0;
   for (const Variant& v : variants)
-    for (const auto& [id, t] : v.tone_by_id) ids[id] += t.pixels;
+    if (!v.tone_by_id.empty()) {
+      for (const auto& [id, t] : v.tone_by_id) ids[id] = t.pixels, all += t.pixels;
+      break;
+    }
   for (const auto& [id, pixels] : ids) {
-    std::printf("%-4d %-24s", id, object_name(shot, id).c_str());
+    std::printf("%-4d %-24s %6.1f%%", id, object_name(shot, id).c_str(),
+                all ? 100.0 * double(pixels) / double(all) : 0.0);
     for (const Variant& v : variants) {
       if (v.tone_by_id.empty()) continue;
       const auto it = v.tone_by_id.find(id);
@@ -442,12 +453,16 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
 // when it is the first one) and, with --save, the frame as a PNG.
 void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& layer,
                    const Image<float>& passes, const Image<float>& prev_passes, int f,
-                   bool drift_frame, const Image<uint8_t>& disoccluded, const Options& opt) {
+                   bool drift_frame, const Image<uint8_t>& disoccluded, const Image<uint8_t>& held,
+                   const Options& opt) {
   const int n = layer.single_colour ? 1 : 3;
   const Image<float> cur = v.store.read_layer(layer, f), prev = v.store.read_layer(layer, f - 1);
   const int mask_channel = cur.channels() > n ? n : -1;
   v.flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                         prev_passes.cview(), mask_channel));
+  if (!held.empty())
+    v.held_flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
+                                               prev_passes.cview(), mask_channel, nullptr, &held));
   if (reference.name == "frame" && v.layer.temporal.enabled) {
     const Image<float> ref = reference.store.read_layer(layer, f);
     v.ghost.add(pipeline::frame_ghost(v.layer, cur.cview(), prev.cview(), ref.cview(),
@@ -505,13 +520,17 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
 // Against frame by frame, same pixels: tone drift and texture kept inside the mask over the last
 // quarter, and both again over the pixels disoccluded within the last few frames (the wash).
 void print_tone_table(const std::vector<Variant>& variants) {
-  std::printf("\n%-24s %9s %9s %11s %11s %12s\n", "variant", "tone", "texture", "wash tone",
-              "wash tex", "wash pixels");
+  // flicker held: the flicker where the light held (bench::light_held) against frame by frame's
+  // there: the chain's own, without what a moving light or shadow changes.
+  const double held_ref = variants[0].held_flicker.all.mean();
+  std::printf("\n%-24s %9s %9s %11s %11s %12s %13s\n", "variant", "tone", "texture", "wash tone",
+              "wash tex", "wash pixels", "flicker held");
   for (const Variant& v : variants) {
     if (!v.tone.pixels) continue;
-    std::printf("%-24s %+9.2f %8.3fx %+11.2f %10.3fx %12ld\n", v.name.c_str(),
+    std::printf("%-24s %+9.2f %8.3fx %+11.2f %10.3fx %12ld %12.2fx\n", v.name.c_str(),
                 v.tone.drift_levels(), v.tone.texture_kept(), v.wash.drift_levels(),
-                v.wash.texture_kept(), v.wash.pixels);
+                v.wash.texture_kept(), v.wash.pixels,
+                held_ref > 0 ? v.held_flicker.all.mean() / held_ref : 0.0);
   }
 }
 
@@ -541,11 +560,16 @@ int main(int argc, char** argv) {
       Image<float> passes = source->passes(f);
       bench::update_disocclusion_age(age, passes.cview(), prev_passes.cview());
       const Image<uint8_t> disoccluded = bench::recently_disoccluded(age, passes.cview());
+      const Image<float> light = bench::light_guides(*layer, passes.cview()),
+                         prev_light = bench::light_guides(*layer, prev_passes.cview());
+      const Image<uint8_t> held =
+          light.empty() ? Image<uint8_t>{}
+                        : bench::light_held(light, prev_light, passes.cview(), kLightTolerance);
       // Drift: the last quarter of the frames (at least one), where a chain has had time to.
       const bool drift_frame = 4 * (last - f) < last - first + 1;
       for (Variant& v : variants)
         measure_frame(v, variants[0], *layer, passes, prev_passes, f, drift_frame, disoccluded,
-                      opt);
+                      held, opt);
       if (judging && (f - first) % opt.judge_every == opt.judge_every / 2) {
         judge_frame(judge_fixed, *layer, passes, f, variants, opt);
         ++judged;

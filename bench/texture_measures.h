@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <vector>
 
 #include "core/image.h"
 #include "pipeline/frames.h"
@@ -87,6 +88,50 @@ inline void add_tone_texture_by_object(std::map<int, ToneTexture>& by_id, const 
       t.energy += double(hv(x, y)) * hv(x, y), t.reference_energy += double(hr(x, y)) * hr(x, y);
       ++t.pixels;
     }
+}
+
+// The layer's guides other than the normals, stacked (empty when it has none): what the light
+// changes.
+inline Image<float> light_guides(const pipeline::Layer& layer, ImageView<const float> passes) {
+  std::vector<Image<float>> parts;
+  int n = 0;
+  for (const pipeline::GuideSpec& g : layer.guides)
+    if (g.pass != "normal") {
+      parts.push_back(pipeline::extract_pass(passes, g.pass));
+      n += parts.back().channels();
+    }
+  if (n == 0) return {};
+  Image<float> out(passes.width, passes.height, n);
+  int c0 = 0;
+  for (const Image<float>& part : parts) {
+    for (int y = 0; y < passes.height; ++y)
+      for (int x = 0; x < passes.width; ++x)
+        for (int c = 0; c < part.channels(); ++c) out(x, y, c0 + c) = part(x, y, c);
+    c0 += part.channels();
+  }
+  return out;
+}
+
+// Where the light on the surface held between t-1 and t: each channel of the layer's guides
+// other than the normals (`current`, `previous`: stacked, values in [0, 1]) differs by at most
+// `tolerance` from its value at the pixel of t-1 the motion vectors point to. The flicker there
+// is the chain's own; elsewhere a moving light or shadow changes what the painting gives.
+inline Image<uint8_t> light_held(const Image<float>& current, const Image<float>& previous,
+                                 ImageView<const float> passes, float tolerance) {
+  const int w = current.width(), h = current.height();
+  Image<uint8_t> out(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* p = passes.at(x, y);
+      const int sx = int(std::lround(x + p[render::kMotion])),
+                sy = int(std::lround(y + p[render::kMotion + 1]));
+      if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
+      bool held = true;
+      for (int c = 0; c < current.channels() && held; ++c)
+        held = std::abs(current(x, y, c) - previous(sx, sy, c)) <= tolerance;
+      out(x, y) = held;
+    }
+  return out;
 }
 
 // Frames since each pixel's surface was last hidden (0: hidden at t-1), carried along the motion

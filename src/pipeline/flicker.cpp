@@ -15,11 +15,12 @@ namespace emaki::pipeline {
 
 FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> prev,
                            ImageView<const float> cp, ImageView<const float> pp, int mask_channel,
-                           Image<float>* map) {
+                           Image<float>* map, const Image<uint8_t>* select) {
   CHECK_EQ(cur.width, prev.width);
   CHECK_EQ(cur.height, prev.height);
   CHECK_EQ(cp.width, cur.width);
   CHECK_EQ(pp.width, cur.width);
+  if (select) CHECK_EQ(select->width(), cur.width);
   FrameFlicker out;
   const int w = cur.width, h = cur.height;
   if (map) *map = empty_qa_map(w, h);
@@ -28,6 +29,7 @@ FrameFlicker frame_flicker(ImageView<const float> cur, ImageView<const float> pr
       const float* p = cp.at(x, y);
       if (p[render::kAlpha] < 1.0f || p[render::kOutline] > 0.0f) continue;
       if (mask_channel >= 0 && cur(x, y, mask_channel) < 1.0f) continue;
+      if (select && !(*select)(x, y)) continue;
       const float id = p[render::kObjectId];
       if (id < 1.0f) continue;
       const float sx = x + p[render::kMotion], sy = y + p[render::kMotion + 1];

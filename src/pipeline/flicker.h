@@ -44,11 +44,12 @@ struct SequenceFlicker {
 // when it and the four pixels it samples in t-1 are fully covered, carry the same object id, no
 // line (silhouettes are where points hide) and, for a masked layer, lie inside both masks.
 // With `map`, it is made the frame's flicker map (pipeline/qa_maps.h): each counted pixel's
-// difference.
+// difference. With `select` (1 channel, the frame's size), only the pixels where it is non-zero
+// count.
 FrameFlicker frame_flicker(ImageView<const float> current, ImageView<const float> previous,
                            ImageView<const float> current_passes,
                            ImageView<const float> previous_passes, int mask_channel,
-                           Image<float>* map = nullptr);
+                           Image<float>* map = nullptr, const Image<uint8_t>* select = nullptr);
 
 // The flicker of `layer`'s finished frames [first, last] (first < last) in `store`, with the
 // passes of `frames`; `each` (may be empty) sees each frame's figures in frame order, and `maps`

@@ -198,6 +198,15 @@ TEST(Pipeline, FlickerBreaksDownByObjectId) {
   EXPECT_NEAR(seq.by_id.at(2).mean(), 0.025, 1e-6);     // (0 + 0.05) / 2 frames
   EXPECT_NEAR(seq.by_id.at(5).mean(), 1.0 / 40, 1e-4);  // measured in one frame only
   EXPECT_EQ(seq.by_id.at(5).pixels, 1);
+  // A selection of the right part alone counts its pixels alone.
+  Image<uint8_t> right(40, 30, 1);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 24; x < 40; ++x) right(x, y) = 1;
+  const FrameFlicker sel =
+      frame_flicker(v1.cview(), v0.cview(), p1.cview(), p0.cview(), -1, nullptr, &right);
+  ASSERT_EQ(sel.by_id.size(), 1u);
+  EXPECT_EQ(sel.by_id.at(5).pixels, ff.by_id.at(5).pixels);
+  EXPECT_NEAR(sel.all.mean(), 1.0 / 40, 1e-4);
 }
 
 TEST(Pipeline, RunsResumesAndContinuesTheChain) {
