@@ -1,5 +1,7 @@
 // A pipeline::Store that keeps layer frames in memory and drops composited frames, so a
-// benchmark times rendering + synthesis + advection + compositing without file output.
+// benchmark times rendering + synthesis + advection + compositing without file output. With
+// `digest` set it folds every layer frame and composited frame it is given into one digest, so
+// two builds can be checked for the same results (bit for bit) on the benchmark's own run.
 #pragma once
 
 #include <cstring>
@@ -14,6 +16,7 @@ namespace emaki::bench {
 
 class MemoryStore : public pipeline::Store {
  public:
+  explicit MemoryStore(bool digest = false) : digesting_(digest) {}
   bool has_layer(const pipeline::Layer& l, int f) const override {
     return layers_.count({l.name, f}) > 0;
   }
@@ -25,12 +28,20 @@ class MemoryStore : public pipeline::Store {
     for (int y = 0; y < v.height; ++y)
       std::memcpy(img.row(y), v.row(y), sizeof(float) * v.width * v.channels);
     layers_[{l.name, f}] = std::move(img);
+    if (digesting_) add(pipeline::value_digest(v));
   }
   bool has_frame(int) const override { return false; }
-  void write_frame(int, ImageView<const float>, const std::vector<ImageView<const float>>&,
-                   ImageView<const float>) override {}
+  void write_frame(int, ImageView<const float> composite,
+                   const std::vector<ImageView<const float>>&, ImageView<const float>) override {
+    if (digesting_) add(pipeline::value_digest(composite));
+  }
+  // Of everything written so far, in the order it was written.
+  uint64_t digest() const { return digest_; }
 
  private:
+  void add(uint64_t h) { digest_ = (digest_ ^ h) * 0x100000001b3ull; }
+  bool digesting_ = false;
+  uint64_t digest_ = 0xcbf29ce484222325ull;
   std::map<std::pair<std::string, int>, Image<float>> layers_;
 };
 

@@ -2,11 +2,13 @@
 // and outline layers, temporal on) at a chosen size, frames kept in memory (no output files),
 // so the figure is rendering + synthesis + advection + compositing.
 //
-//   shot_bench [WIDTHxHEIGHT=1920x1080] [FRAMES=3] [THREADS=0]
+//   shot_bench [--digest] [WIDTHxHEIGHT=1920x1080] [FRAMES=3] [THREADS=0]
 //
 // Frame 0 has no temporal guide; the figure that matters is the mean of the later frames. The
 // split of those frames by layer follows (a layer's time includes its advection, and the first
 // layer's the frame's rendering; "compositing" runs from the composite's start to the next frame).
+// With --digest it also prints a digest of every layer frame and composited frame (equal
+// digests, equal results); computing it adds to the frames' times.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -25,8 +27,10 @@ int main(int argc, char** argv) {
   emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   using namespace emaki;
   int width = 1920, height = 1080, frames = 3, threads = 0;
+  const bool digest = argc > 1 && std::string(argv[1]) == "--digest";
+  if (digest) --argc, ++argv;
   if (argc > 1 && std::sscanf(argv[1], "%dx%d", &width, &height) != 2) {
-    std::fprintf(stderr, "usage: shot_bench [WIDTHxHEIGHT] [FRAMES] [THREADS]\n");
+    std::fprintf(stderr, "usage: shot_bench [--digest] [WIDTHxHEIGHT] [FRAMES] [THREADS]\n");
     return 2;
   }
   if (argc > 2) frames = std::max(2, std::atoi(argv[2]));
@@ -41,7 +45,7 @@ int main(int argc, char** argv) {
     const auto source = shot::open_frames(shot);
     const auto exemplars = shot::load_exemplars(shot);
     const pipeline::CompositeInputs ci = shot::load_composite_inputs(shot);
-    bench::MemoryStore store;
+    bench::MemoryStore store(digest);
     std::vector<double> seconds;
     auto t = std::chrono::steady_clock::now();
     int last = -1;
@@ -84,6 +88,9 @@ int main(int argc, char** argv) {
     for (const std::string& name : order)
       std::printf(" %s %.2f s", name.c_str(), step_seconds[name] / double(frames - 1));
     std::printf("\n");
+    if (digest)
+      std::printf("shot_bench: digest of the layer and composited frames %016llx\n",
+                  static_cast<unsigned long long>(store.digest()));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shot_bench: %s\n", e.what());
     return 1;
