@@ -49,6 +49,24 @@ const temporal::AdvectionField* AdvectionFields::find(const Layer& l, int frame)
   return nullptr;
 }
 
+const Image<float>& AdvectionFields::guide(ImageView<const float> passes, AdvectionGuide guide) {
+  return cut(passes, int(guide));
+}
+
+const Image<float>& AdvectionFields::motion(ImageView<const float> passes) {
+  return cut(passes, -1);
+}
+
+const Image<float>& AdvectionFields::cut(ImageView<const float> passes, int what) {
+  for (const auto& c : cuts_)
+    if (c->passes == passes.data && c->what == what) return c->image;
+  cuts_.push_back(std::make_unique<Cut>(
+      Cut{passes.data, what,
+          what < 0 ? extract(passes, render::kMotion, 2)
+                   : advection_guide(passes, static_cast<AdvectionGuide>(what))}));
+  return cuts_.back()->image;
+}
+
 Image<int32_t> carry_field(ImageView<const int32_t> previous, const temporal::AdvectionField& f) {
   const int w = f.nnf.width(), h = f.nnf.height();
   if (previous.width != w || previous.height != h || previous.channels != 2) return {};
@@ -107,8 +125,11 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
                                  ImageView<const float> previous_passes, int frame,
                                  AdvectionFields* fields) {
-  const Image<float> guide_prev = advection_guide(previous_passes, l.temporal.guide);
-  const Image<float> guide_cur = advection_guide(passes, l.temporal.guide);
+  // The frame's cuts, shared through `fields` or made for this call.
+  AdvectionFields own;
+  AdvectionFields& cuts = fields ? *fields : own;
+  const Image<float>& guide_prev = cuts.guide(previous_passes, l.temporal.guide);
+  const Image<float>& guide_cur = cuts.guide(passes, l.temporal.guide);
   temporal::AdvectionInputs a;
   a.previous_stylized = previous;
   a.value_channels = l.single_colour ? 1 : 3;
@@ -117,16 +138,11 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
   a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
   if (!mask.empty()) a.current_mask = mask.cview();
   // The confidence's evidence: the surfaces (rest position + object id) whatever the guide.
-  Image<float> surf_prev, surf_cur, motion, change_prev, change_cur;
+  Image<float> change_prev, change_cur;
   if (l.temporal.confidence) {
-    const bool rest = l.temporal.guide == AdvectionGuide::kRestPosition;
-    if (!rest) {
-      surf_prev = advection_guide(previous_passes, AdvectionGuide::kRestPosition);
-      surf_cur = advection_guide(passes, AdvectionGuide::kRestPosition);
-    }
-    motion = extract(passes, render::kMotion, 2);
-    a.surfaces = temporal::Surfaces{rest ? guide_prev.cview() : surf_prev.cview(),
-                                    rest ? guide_cur.cview() : surf_cur.cview(), motion.cview()};
+    const AdvectionGuide rest = AdvectionGuide::kRestPosition;
+    a.surfaces = temporal::Surfaces{cuts.guide(previous_passes, rest).cview(),
+                                    cuts.guide(passes, rest).cview(), cuts.motion(passes).cview()};
     a.confidence = l.temporal.confidence_params;
     if (a.confidence.change_none > 0.0f) {
       change_prev = change_guides(l, previous_passes);

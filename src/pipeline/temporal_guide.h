@@ -47,8 +47,20 @@ class AdvectionFields {
                                       const std::function<temporal::AdvectionField()>& compute);
   // The field get() gave `layer` at `frame`, or null when it has not been computed.
   const temporal::AdvectionField* find(const Layer& layer, int frame) const;
+  // What every layer cuts from a frame's passes (the frame's or the one before), cut once:
+  // advection_guide(passes, guide), and the motion (2 channels). `passes` must stay the same
+  // image while this object lives.
+  const Image<float>& guide(ImageView<const float> passes, AdvectionGuide guide);
+  const Image<float>& motion(ImageView<const float> passes);
 
  private:
+  struct Cut {
+    const float* passes;
+    int what;  // an AdvectionGuide, or -1: the motion
+    Image<float> image;
+  };
+  const Image<float>& cut(ImageView<const float> passes, int what);
+  std::vector<std::unique_ptr<Cut>> cuts_;  // stable addresses
   struct Entry {
     AdvectionGuide guide;
     int patch_size;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "core/parallel.h"
 #include "synth/voting.h"
 #include "temporal/guide_change.h"
 
@@ -35,8 +36,10 @@ synth::Params field_params(const synth::Params& params, int search_radius, int w
 // synthesizer's own rule (synth::Inputs::target_mask).
 Image<uint8_t> active_region(ImageView<const float> mask, int r) {
   Image<uint8_t> inside(mask.width, mask.height, 1);
-  for (int y = 0; y < mask.height; ++y)
-    for (int x = 0; x < mask.width; ++x) inside(x, y) = mask.at(x, y)[0] > 0.0f ? 1 : 0;
+  parallel_rows(mask.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < mask.width; ++x) inside(x, y) = mask.at(x, y)[0] > 0.0f ? 1 : 0;
+  });
   return synth::dilate_mask(inside, r);
 }
 
@@ -58,7 +61,10 @@ AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& p
   f.nnf = std::move(r.nnf);
   f.error = std::move(r.error);
   f.patch_size = p.patch_size;
-  if (in.surfaces) f.visible = visible_before(*in.surfaces);
+  if (in.surfaces) {
+    f.visible = visible_before(*in.surfaces);
+    f.shares = id_shares(in.surfaces->previous, f.patch_size / 2);
+  }
   return f;
 }
 
@@ -79,12 +85,14 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params,
   // The style is B'(t-1)'s value, with the empty value where it had no content, so that the
   // advection never copies the transparent area's zeros into the current frame.
   Image<float> style(prev.width, prev.height, n);
-  for (int y = 0; y < prev.height; ++y)
-    for (int x = 0; x < prev.width; ++x) {
-      const float* p = prev.at(x, y);
-      const float a = masked ? p[n] : 1.0f;
-      for (int c = 0; c < n; ++c) style(x, y, c) = a * p[c] + (1.0f - a) * in.empty_value;
-    }
+  parallel_rows(prev.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < prev.width; ++x) {
+        const float* p = prev.at(x, y);
+        const float a = masked ? p[n] : 1.0f;
+        for (int c = 0; c < n; ++c) style(x, y, c) = a * p[c] + (1.0f - a) * in.empty_value;
+      }
+  });
   Image<uint8_t> active;
   if (in.current_mask) active = active_region(*in.current_mask, patch / 2);
   Image<float> voted;
@@ -94,13 +102,19 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params,
   if (in.surfaces) {
     // The evidence of this layer's B'adv: the patches that vote it (those centred inside its
     // active region) and their errors.
-    Image<int32_t> nnf = field->nnf.clone();
     Image<float> error = field->error.clone();
-    for (int y = 0; y < h && !active.empty(); ++y)
-      for (int x = 0; x < w; ++x)
-        if (!active(x, y)) nnf(x, y, 0) = nnf(x, y, 1) = -1, error(x, y) = 0.0f;
+    if (!active.empty())
+      parallel_rows(h, 32, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+          for (int x = 0; x < w; ++x)
+            if (!active(x, y)) error(x, y) = 0.0f;
+      });
     out.visible = field->visible.empty() ? visible_before(*in.surfaces) : field->visible.clone();
-    out.foreign = foreign_share(nnf, *in.surfaces, patch, patch / 2);
+    // A field made without surfaces has no shared evidence: it is counted here.
+    const bool shared = !field->shares.empty();
+    const IdShares own_shares = shared ? IdShares{} : id_shares(in.surfaces->previous, patch / 2);
+    out.foreign =
+        foreign_share(field->nnf, active, *in.surfaces, patch, shared ? field->shares : own_shares);
     Image<float> change;
     if (in.previous_layer_guides && in.current_layer_guides && in.confidence.change_none > 0.0f)
       change = guide_change(field->nnf, *in.previous_layer_guides, *in.current_layer_guides);
@@ -112,12 +126,15 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params,
   }
   // Outside the mask the value is the empty value.
   out.value.reset(w, h, n);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const float a = std::clamp(in.current_mask->at(x, y)[0], 0.0f, 1.0f);
-      for (int c = 0; c < n; ++c)
-        out.value(x, y, c) = a * (a <= 0.0f ? 0.0f : voted(x, y, c)) + (1.0f - a) * in.empty_value;
-    }
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float a = std::clamp(in.current_mask->at(x, y)[0], 0.0f, 1.0f);
+        for (int c = 0; c < n; ++c)
+          out.value(x, y, c) =
+              a * (a <= 0.0f ? 0.0f : voted(x, y, c)) + (1.0f - a) * in.empty_value;
+      }
+  });
   return out;
 }
 

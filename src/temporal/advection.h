@@ -51,11 +51,13 @@ struct Advection {
 // patch error; with surfaces, visible_before() too. It does not depend on B'(t-1) or on a
 // layer's mask, so one field serves every layer of a frame that advects with the same guide,
 // patch size and seed (pipeline/temporal_guide.h). Reads `in`'s guides, search radius and
-// surfaces only.
+// surfaces only. With surfaces it also keeps the part of the confidence's evidence that no
+// layer changes: visible_before() and the id shares of t-1 that foreign_share() reads.
 struct AdvectionField {
   Image<int32_t> nnf;      // the current frame's size, 2 channels
   Image<float> error;      // EbSynth units
   Image<uint8_t> visible;  // with surfaces (else empty)
+  IdShares shares;         // with surfaces: id_shares(previous surfaces, patch_size / 2)
   int patch_size = 0;
 };
 AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& params);

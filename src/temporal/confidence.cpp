@@ -68,19 +68,6 @@ Image<uint8_t> visible_before(const Surfaces& s, float tolerance) {
 
 namespace {
 
-// For each id k present in `ids` (channel 3), the share of the pixels within `radius` of each
-// pixel (clamped window) that show k: one box-filtered indicator per id.
-struct IdShares {
-  std::vector<float> ids;
-  std::vector<Image<float>> share;  // parallel to ids
-  // The share of the window around (x, y) showing id k (0 for an id not present).
-  float of(float k, int x, int y) const {
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      if (ids[i] == k) return share[i](x, y);
-    return 0.0f;
-  }
-};
-
 Image<float> box_share(ImageView<const float> ids, float k, int radius) {
   const int w = ids.width, h = ids.height;
   Image<float> rows(w, h, 1), out(w, h, 1);
@@ -106,35 +93,57 @@ Image<float> box_share(ImageView<const float> ids, float k, int radius) {
   return out;
 }
 
+}  // namespace
+
 IdShares id_shares(ImageView<const float> ids, int radius) {
   IdShares s;
-  for (int y = 0; y < ids.height; ++y)
-    for (int x = 0; x < ids.width; ++x) {
-      const float k = ids(x, y, 3);
+  s.radius = radius;
+  // The ids of each band of rows in first-seen order, then merged in band order: the order of a
+  // scan of the whole image row by row.
+  const int band = 32, bands = (ids.height + band - 1) / band;
+  std::vector<std::vector<float>> seen(std::size_t(std::max(bands, 0)));
+  parallel_for(bands, 1, [&](int64_t b0, int64_t b1) {
+    for (int64_t b = b0; b < b1; ++b)
+      for (int y = int(b) * band; y < std::min(ids.height, int(b + 1) * band); ++y)
+        for (int x = 0; x < ids.width; ++x) {
+          const float k = ids(x, y, 3);
+          std::vector<float>& v = seen[std::size_t(b)];
+          if (std::find(v.begin(), v.end(), k) == v.end()) v.push_back(k);
+        }
+  });
+  for (const std::vector<float>& v : seen)
+    for (float k : v)
       if (std::find(s.ids.begin(), s.ids.end(), k) == s.ids.end()) s.ids.push_back(k);
-    }
   for (float k : s.ids) s.share.push_back(box_share(ids, k, radius));
   return s;
 }
 
-}  // namespace
-
 Image<float> foreign_share(const Image<int32_t>& nnf, const Surfaces& s, int patch_size,
                            int footprint) {
+  return foreign_share(nnf, {}, s, patch_size, id_shares(s.previous, footprint));
+}
+
+Image<float> foreign_share(const Image<int32_t>& nnf, const Image<uint8_t>& active,
+                           const Surfaces& s, int patch_size, const IdShares& shares) {
   const ImageView<const float> prev = s.previous, cur = s.current;
   const int w = nnf.width(), h = nnf.height(), r = patch_size / 2;
   CHECK_EQ(cur.width, w);
   CHECK_EQ(cur.height, h);
-  const IdShares shares = id_shares(prev, footprint);
+  CHECK(!shares.empty());
+  const bool all = active.empty();
+  CHECK(all || (active.width() == w && active.height() == h));
   Image<float> out(w, h, 1);
   parallel_rows(h, 32, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < w; ++x) {
+        const int ux0 = std::max(0, x - r), ux1 = std::min(w - 1, x + r);
+        const int uy0 = std::max(0, y - r), uy1 = std::min(h - 1, y + r);
         const float id = cur(x, y, 3);
         int votes = 0;
         float foreign = 0.0f;
-        for (int uy = std::max(0, y - r); uy <= std::min(h - 1, y + r); ++uy)
-          for (int ux = std::max(0, x - r); ux <= std::min(w - 1, x + r); ++ux) {
+        for (int uy = uy0; uy <= uy1; ++uy)
+          for (int ux = ux0; ux <= ux1; ++ux) {
+            if (!all && !active(ux, uy)) continue;
             const int32_t* m = nnf.at(ux, uy);
             if (m[0] < 0) continue;
             const int qx = m[0] + (x - ux), qy = m[1] + (y - uy);

@@ -8,6 +8,8 @@
 // it as the temporal guide's weight map.
 #pragma once
 
+#include <vector>
+
 #include "core/image.h"
 
 namespace emaki::temporal {
@@ -38,6 +40,28 @@ Image<uint8_t> visible_before(const Surfaces& s, float tolerance = 3.0f);
 // another object's silhouette carries that object's bleed. Pixels no patch votes are 0.
 Image<float> foreign_share(const Image<int32_t>& nnf, const Surfaces& s, int patch_size,
                            int footprint);
+
+// For each object id of frame t-1 (Surfaces::previous' channel 3), the share of the pixels within
+// `radius` of each pixel (clamped window) that show it: foreign_share()'s evidence from frame t-1,
+// which depends on neither a layer's field nor its mask, so one serves every layer of a frame.
+struct IdShares {
+  int radius = -1;
+  std::vector<float> ids;
+  std::vector<Image<float>> share;  // parallel to ids
+  bool empty() const { return radius < 0; }
+  // The share of the window around (x, y) showing id k (0 for an id not present).
+  float of(float k, int x, int y) const {
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (ids[i] == k) return share[i](x, y);
+    return 0.0f;
+  }
+};
+IdShares id_shares(ImageView<const float> previous, int radius);
+
+// foreign_share(nnf', s, patch_size, shares.radius) where nnf' is `nnf` with -1 at the patch
+// centres outside `active` (empty: none), from `shares` (id_shares(s.previous, footprint)).
+Image<float> foreign_share(const Image<int32_t>& nnf, const Image<uint8_t>& active,
+                           const Surfaces& s, int patch_size, const IdShares& shares);
 
 // How the evidence becomes a confidence (defaults measured on the example,
 // docs/design/temporal-confidence.md).

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "temporal/advection.h"
@@ -93,6 +94,32 @@ TEST(Confidence, ForeignShareCountsVotesFromAnotherObject) {
   EXPECT_EQ(f(kX0 - 1, kY0 + 8), 0.0f);
   EXPECT_FLOAT_EQ(g(kX0 - 1, kY0 + 8), 0.4f);
   EXPECT_EQ(g(5, 5), 0.0f);
+}
+
+// Over a mask, from shared id shares: the same, bit for bit, as the field with -1 outside the
+// mask.
+TEST(Confidence, ForeignShareOverAMaskIsTheMaskedFields) {
+  const Scene s;
+  Image<int32_t> nnf(kW, kH, 2), masked(kW, kH, 2);
+  Image<uint8_t> active(kW, kH, 1);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      nnf(x, y, 0) = std::clamp(x + int(s.mot(x, y, 0)) + (x * 7 + y * 3) % 5 - 2, 2, kW - 3);
+      nnf(x, y, 1) = std::clamp(y + (x * 5 + y) % 3 - 1, 2, kH - 3);
+      active(x, y) = (x - 30) * (x - 30) + (y - 22) * (y - 22) < 150 ? 1 : 0;
+      masked(x, y, 0) = active(x, y) ? nnf(x, y, 0) : -1;
+      masked(x, y, 1) = active(x, y) ? nnf(x, y, 1) : -1;
+    }
+  const IdShares shares = id_shares(s.prev.cview(), 2);
+  const Image<float> expected = foreign_share(masked, s.surfaces(), 5, 2);
+  const Image<float> got = foreign_share(nnf, active, s.surfaces(), 5, shares);
+  int inside = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      EXPECT_EQ(got(x, y), expected(x, y)) << x << "," << y;
+      inside += expected(x, y) > 0.0f ? 1 : 0;
+    }
+  EXPECT_GT(inside, 0);
 }
 
 TEST(Confidence, ErrorRampAndErosion) {
