@@ -103,13 +103,26 @@ struct TemporalPair {
   Image<float> target;
 };
 
+// Whether the layer's temporal pair joins its main transfer. A pair of weight 0 changes no
+// patch's error (its channels quantise to 0 on both sides; the other channels' weights, and with
+// them the distances and errors, stay the same to the bit): it is left out, and its advection
+// makes the confidence alone (the warm start's holes) — unless a guide's weight is negative
+// (1 / the number of pairs, which leaving one out would change).
+bool keeps_temporal_pair(const Layer& l) {
+  return l.temporal.weight != 0.0f ||
+         std::any_of(l.guides.begin(), l.guides.end(),
+                     [](const GuideSpec& g) { return g.weight < 0.0f; });
+}
+
 void add_temporal_guide(const PreparedLayer& p, ImageView<const float> passes,
                         const Image<float>& mask, int frame, const Image<float>& previous,
                         const Image<float>& previous_passes, AdvectionFields* fields,
                         TemporalPair& t, synth::Inputs& inputs) {
   const Layer& l = *p.layer;
+  const bool kept = keeps_temporal_pair(l);
   t.advected =
-      advect_layer(l, passes, mask, previous.cview(), previous_passes.cview(), frame, fields);
+      advect_layer(l, passes, mask, previous.cview(), previous_passes.cview(), frame, fields, kept);
+  if (!kept) return;
   const bool low = p.sharpening.guide_sigma > 0.0f;
   if (low)
     t.target = temporal::low_pass(t.advected.value.cview(), p.sharpening.guide_sigma,
@@ -131,7 +144,7 @@ Anchor anchor_layer(const PreparedLayer& p, int frame, const synth::Params& para
       (!guide && !l.temporal.anchor_holes && l.temporal.ink_match <= 0.0f))
     return {};
   synth::Inputs fresh = inputs;
-  fresh.guides.pop_back();  // the temporal pair
+  if (keeps_temporal_pair(l)) fresh.guides.pop_back();
   synth::Params fresh_params = params;
   fresh_params.seed = frame_seed(l, frame, 2);
   fresh_params.finest_search_vote_iters = l.temporal.anchor_finest_iters;
@@ -191,15 +204,15 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   if (!mask.empty()) inputs.target_mask = mask.cview();
   synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
   if (o) params.cancel = o->cancel;
-  const Anchor anchor = advected.value.empty()
-                            ? Anchor{}
-                            : anchor_layer(p, frame, params, mask, temporal_pair, inputs);
+  const bool chained = previous && previous_passes;
+  const Anchor anchor =
+      chained ? anchor_layer(p, frame, params, mask, temporal_pair, inputs) : Anchor{};
   // With a temporal guide, B'adv already carries the previous frame's converged texture: one
   // search-vote iteration at the finest level instead of two keeps flicker and the judge's
   // style energy within their bars (measured on the example, docs/design/advection.md) and saves
   // about a quarter of the time per frame.
   Image<int32_t> warm;
-  if (!advected.value.empty()) {
+  if (chained) {
     params.finest_search_vote_iters = l.temporal.finest_iters;
     params.uniformity = l.temporal.uniformity;
     const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;

@@ -124,7 +124,7 @@ Image<float> change_guides(const Layer& l, ImageView<const float> passes) {
 temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
                                  ImageView<const float> previous_passes, int frame,
-                                 AdvectionFields* fields) {
+                                 AdvectionFields* fields, bool value) {
   // The frame's cuts, shared through `fields` or made for this call.
   AdvectionFields own;
   AdvectionFields& cuts = fields ? *fields : own;
@@ -133,6 +133,7 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
   temporal::AdvectionInputs a;
   a.previous_stylized = previous;
   a.value_channels = l.single_colour ? 1 : 3;
+  a.value = value;
   a.previous_guide = guide_prev.cview();
   a.current_guide = guide_cur.cview();
   a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";

@@ -74,11 +74,12 @@ class AdvectionFields {
 // the mask coverage when it has a mask) and the passes of both frames. `mask`: the layer's mask
 // at `frame` (empty: none). With layer.temporal.confidence the result carries the confidence.
 // `fields`: the frame's fields so far (the field is taken from there, or computed and added);
-// null: computed for this call alone — the same field either way.
+// null: computed for this call alone — the same field either way. `value` false: the
+// confidence alone (temporal::AdvectionInputs::value).
 temporal::Advection advect_layer(const Layer& layer, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
                                  ImageView<const float> previous_passes, int frame,
-                                 AdvectionFields* fields = nullptr);
+                                 AdvectionFields* fields = nullptr, bool value = true);
 
 // The warm start of a layer's main transfer at a frame (TemporalSpec::warm_start): `previous`,
 // its field at the frame before (Result::nnf: the exemplar patch centre per pixel, (-1, -1)

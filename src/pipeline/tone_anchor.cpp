@@ -116,6 +116,15 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
   request.nnf = true;
   const synth::Result fresh = synth::synthesize(s, p, request);
 
+  Anchor a;
+  const synth::Plane& full = inputs.guides.front().target;
+  a.nnf = spread_field(fresh.nnf, synth::plane_width(full), synth::plane_height(full), halvings);
+  a.fresh = extract(fresh.image.cview(), 0, value_channels);
+  a.halvings = halvings;
+  if (advected.empty()) {
+    a.small_mask = std::move(small_mask);
+    return a;
+  }
   // The difference, fresh minus carried, at the small size, low-passed inside the mask.
   const int n = value_channels;
   const Image<float> carried = halve(extract(advected, 0, n), halvings);
@@ -128,13 +137,9 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
   const Image<float> smooth = temporal::low_pass(
       diff.cview(), sigma, small_mask.empty() ? ImageView<const float>{} : small_mask.cview());
 
-  Anchor a;
-  a.fresh = extract(fresh.image.cview(), 0, n);
   a.small_mask = std::move(small_mask);
-  a.halvings = halvings;
   Image<float>& out = a.target;
   out.reset(advected.width, advected.height, n);
-  a.nnf = spread_field(fresh.nnf, advected.width, advected.height, halvings);
   const float fx = float(sw) / float(advected.width), fy = float(sh) / float(advected.height);
   for (int y = 0; y < advected.height; ++y)
     for (int x = 0; x < advected.width; ++x)

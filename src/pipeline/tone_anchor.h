@@ -25,7 +25,8 @@ AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synt
 // `mask`: the layer's mask at the frame (empty: none). The fresh transfer runs with every input
 // halved exemplar.halvings times; the difference of the two, low-passed by `sigma` pixels at that
 // size and inside the mask, is added back at full size, times `rate`. Both members are empty when
-// the frame or the mask is too small to synthesize at that size.
+// the frame or the mask is too small to synthesize at that size; `advected` empty: the field
+// alone.
 struct Anchor {
   Image<float> target;      // the anchored B'adv (value channels)
   Image<int32_t> nnf;       // the fresh transfer's field scaled to full size ((-1, -1) outside it)

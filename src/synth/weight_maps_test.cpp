@@ -89,6 +89,22 @@ TEST(WeightMaps, MapOfZerosEqualsDroppingTheGuide) {
   EXPECT_FALSE(same_bits(with.image, run(t.inputs()).image));  // the guide did count
 }
 
+// A pair of weight 0 changes nothing, whatever its map: its channels quantise to 0 on both sides
+// and the other channels' weights stay as they were (the pipeline leaves a temporal pair of
+// weight 0 out on this ground).
+TEST(WeightMaps, PairOfWeightZeroEqualsDroppingIt) {
+  const TwoGuides t;
+  const Image<float> map = noise(80, 60, 1, 26);
+  Inputs zero = t.inputs(0.0f);
+  zero.guides[0].weight_map = Plane(map.cview());
+  Inputs dropped = t.inputs();
+  dropped.guides.erase(dropped.guides.begin());
+  const Result with = run(zero), without = run(dropped);
+  EXPECT_TRUE(same_bits(with.image, without.image));
+  EXPECT_TRUE(same_bits(with.error, without.error));
+  EXPECT_TRUE(same_nnf(with.nnf, without.nnf));
+}
+
 // A constant map c on weight w acts as the weight c x w. Not bit for bit: the guide's channels
 // are quantised for w either way, and c multiplies their sum.
 TEST(WeightMaps, ConstantMapActsAsTheWeight) {

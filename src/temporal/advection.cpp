@@ -68,6 +68,34 @@ AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& p
   return f;
 }
 
+namespace {
+
+// The confidence of a layer's B'adv and its evidence: the patches that vote it (those centred
+// inside its active region, `active`; empty: all) and their errors.
+void add_confidence(const AdvectionInputs& in, const AdvectionField& field,
+                    const Image<uint8_t>& active, Advection& out) {
+  const int w = field.nnf.width(), h = field.nnf.height(), patch = field.patch_size;
+  Image<float> error = field.error.clone();
+  if (!active.empty())
+    parallel_rows(h, 32, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < w; ++x)
+          if (!active(x, y)) error(x, y) = 0.0f;
+    });
+  out.visible = field.visible.empty() ? visible_before(*in.surfaces) : field.visible.clone();
+  // A field made without surfaces has no shared evidence: it is counted here.
+  const bool shared = !field.shares.empty();
+  const IdShares own_shares = shared ? IdShares{} : id_shares(in.surfaces->previous, patch / 2);
+  out.foreign =
+      foreign_share(field.nnf, active, *in.surfaces, patch, shared ? field.shares : own_shares);
+  Image<float> change;
+  if (in.previous_layer_guides && in.current_layer_guides && in.confidence.change_none > 0.0f)
+    change = guide_change(field.nnf, *in.previous_layer_guides, *in.current_layer_guides);
+  out.confidence = confidence(out.visible, out.foreign, error, patch, in.confidence, change);
+}
+
+}  // namespace
+
 Advection advect(const AdvectionInputs& in, const synth::Params& params,
                  const AdvectionField* field) {
   const ImageView<const float> prev = in.previous_stylized;
@@ -81,9 +109,14 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params,
     field = &own;
   }
   const int w = field->nnf.width(), h = field->nnf.height(), patch = field->patch_size;
-  const bool masked = prev.channels > n;
+  Image<uint8_t> active;
+  if (in.current_mask) active = active_region(*in.current_mask, patch / 2);
+  Advection out;
+  if (in.surfaces) add_confidence(in, *field, active, out);
+  if (!in.value) return out;
   // The style is B'(t-1)'s value, with the empty value where it had no content, so that the
   // advection never copies the transparent area's zeros into the current frame.
+  const bool masked = prev.channels > n;
   Image<float> style(prev.width, prev.height, n);
   parallel_rows(prev.height, 32, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
@@ -93,33 +126,9 @@ Advection advect(const AdvectionInputs& in, const synth::Params& params,
         for (int c = 0; c < n; ++c) style(x, y, c) = a * p[c] + (1.0f - a) * in.empty_value;
       }
   });
-  Image<uint8_t> active;
-  if (in.current_mask) active = active_region(*in.current_mask, patch / 2);
   Image<float> voted;
   synth::vote(synth::Plane(style.cview()), field->nnf, field->error, active, patch,
               params.vote_mode, voted);
-  Advection out;
-  if (in.surfaces) {
-    // The evidence of this layer's B'adv: the patches that vote it (those centred inside its
-    // active region) and their errors.
-    Image<float> error = field->error.clone();
-    if (!active.empty())
-      parallel_rows(h, 32, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < w; ++x)
-            if (!active(x, y)) error(x, y) = 0.0f;
-      });
-    out.visible = field->visible.empty() ? visible_before(*in.surfaces) : field->visible.clone();
-    // A field made without surfaces has no shared evidence: it is counted here.
-    const bool shared = !field->shares.empty();
-    const IdShares own_shares = shared ? IdShares{} : id_shares(in.surfaces->previous, patch / 2);
-    out.foreign =
-        foreign_share(field->nnf, active, *in.surfaces, patch, shared ? field->shares : own_shares);
-    Image<float> change;
-    if (in.previous_layer_guides && in.current_layer_guides && in.confidence.change_none > 0.0f)
-      change = guide_change(field->nnf, *in.previous_layer_guides, *in.current_layer_guides);
-    out.confidence = confidence(out.visible, out.foreign, error, patch, in.confidence, change);
-  }
   if (!in.current_mask) {
     out.value = std::move(voted);
     return out;

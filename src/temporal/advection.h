@@ -36,10 +36,14 @@ struct AdvectionInputs {
   // t-1 and t; the confidence then also drops where they changed along the field
   // (ConfidenceParams::change_*): a lighting change is re-synthesized, not carried.
   std::optional<ImageView<const float>> previous_layer_guides, current_layer_guides;
+  // False: the confidence alone (with surfaces), for a layer whose temporal guide has weight 0;
+  // B'adv is then not voted and Advection::value stays empty.
+  bool value = true;
 };
 
 struct Advection {
-  Image<float> value;  // B'adv, the size of the current frame, `value_channels` channels
+  Image<float> value;  // B'adv, the size of the current frame, `value_channels` channels (or
+                       // empty: AdvectionInputs::value)
   // With surfaces (else empty): the confidence in [0, 1] and the evidence it was made from.
   Image<float> confidence;
   Image<uint8_t> visible;  // visible_before()
