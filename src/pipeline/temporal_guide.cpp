@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/parallel.h"
 #include "core/rng.h"
 #include "pipeline/frames.h"
 #include "render/passes.h"
@@ -71,13 +72,15 @@ Image<int32_t> carry_field(ImageView<const int32_t> previous, const temporal::Ad
   const int w = f.nnf.width(), h = f.nnf.height();
   if (previous.width != w || previous.height != h || previous.channels != 2) return {};
   Image<int32_t> out(w, h, 2);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const int32_t qx = f.nnf(x, y, 0), qy = f.nnf(x, y, 1);
-      const bool inside = qx >= 0 && qx < w && qy >= 0 && qy < h;
-      out(x, y, 0) = inside ? previous(qx, qy, 0) : -1;
-      out(x, y, 1) = inside ? previous(qx, qy, 1) : -1;
-    }
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        const int32_t qx = f.nnf(x, y, 0), qy = f.nnf(x, y, 1);
+        const bool inside = qx >= 0 && qx < w && qy >= 0 && qy < h;
+        out(x, y, 0) = inside ? previous(qx, qy, 0) : -1;
+        out(x, y, 1) = inside ? previous(qx, qy, 1) : -1;
+      }
+  });
   return out;
 }
 
@@ -86,12 +89,14 @@ Image<int32_t> warm_field(const Layer& l, ImageView<const int32_t> previous,
                           const Image<int32_t>& fresh) {
   Image<int32_t> warm = carry_field(previous, field);
   if ((!l.temporal.reseed && fresh.empty()) || warm.empty() || confidence.empty()) return warm;
-  for (int y = 0; y < warm.height(); ++y)
-    for (int x = 0; x < warm.width(); ++x)
-      if (confidence(x, y) <= 0.0f) {
-        warm(x, y, 0) = fresh.empty() ? -1 : fresh(x, y, 0);
-        warm(x, y, 1) = fresh.empty() ? -1 : fresh(x, y, 1);
-      }
+  parallel_rows(warm.height(), 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < warm.width(); ++x)
+        if (confidence(x, y) <= 0.0f) {
+          warm(x, y, 0) = fresh.empty() ? -1 : fresh(x, y, 0);
+          warm(x, y, 1) = fresh.empty() ? -1 : fresh(x, y, 1);
+        }
+  });
   return warm;
 }
 

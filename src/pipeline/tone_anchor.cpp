@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/parallel.h"
 #include "pipeline/frames.h"
 #include "synth/pyramid.h"
 #include "temporal/guide_change.h"
@@ -19,9 +20,11 @@ Image<float> to_float(const synth::Plane& plane) {
   return std::visit(
       [](const auto& v) {
         Image<float> out(v.width, v.height, v.channels);
-        for (int y = 0; y < v.height; ++y)
-          for (int x = 0; x < v.width; ++x)
-            for (int c = 0; c < v.channels; ++c) out(x, y, c) = normalised(v(x, y, c));
+        parallel_rows(v.height, 32, [&](int y0, int y1) {
+          for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < v.width; ++x)
+              for (int c = 0; c < v.channels; ++c) out(x, y, c) = normalised(v(x, y, c));
+        });
         return out;
       },
       plane);
@@ -47,15 +50,17 @@ float sample(const Image<float>& im, float x, float y, int c) {
 // 2^halvings pixels it covers, offset within it; (-1, -1) stays outside.
 Image<int32_t> spread_field(const Image<int32_t>& small, int width, int height, int halvings) {
   Image<int32_t> out(width, height, 2);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const int xs = std::min(x >> halvings, small.width() - 1);
-      const int ys = std::min(y >> halvings, small.height() - 1);
-      const int32_t sx = small(xs, ys, 0), sy = small(xs, ys, 1);
-      const bool in = sx >= 0 && sy >= 0;
-      out(x, y, 0) = in ? (sx << halvings) + (x - (xs << halvings)) : -1;
-      out(x, y, 1) = in ? (sy << halvings) + (y - (ys << halvings)) : -1;
-    }
+  parallel_rows(height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x) {
+        const int xs = std::min(x >> halvings, small.width() - 1);
+        const int ys = std::min(y >> halvings, small.height() - 1);
+        const int32_t sx = small(xs, ys, 0), sy = small(xs, ys, 1);
+        const bool in = sx >= 0 && sy >= 0;
+        out(x, y, 0) = in ? (sx << halvings) + (x - (xs << halvings)) : -1;
+        out(x, y, 1) = in ? (sy << halvings) + (y - (ys << halvings)) : -1;
+      }
+  });
   return out;
 }
 
@@ -141,13 +146,15 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
   Image<float>& out = a.target;
   out.reset(advected.width, advected.height, n);
   const float fx = float(sw) / float(advected.width), fy = float(sh) / float(advected.height);
-  for (int y = 0; y < advected.height; ++y)
-    for (int x = 0; x < advected.width; ++x)
-      for (int c = 0; c < n; ++c) {
-        const float d =
-            rate * sample(smooth, (float(x) + 0.5f) * fx - 0.5f, (float(y) + 0.5f) * fy - 0.5f, c);
-        out(x, y, c) = std::clamp(advected(x, y, c) + d, 0.0f, 1.0f);
-      }
+  parallel_rows(advected.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < advected.width; ++x)
+        for (int c = 0; c < n; ++c) {
+          const float d = rate * sample(smooth, (float(x) + 0.5f) * fx - 0.5f,
+                                        (float(y) + 0.5f) * fy - 0.5f, c);
+          out(x, y, c) = std::clamp(advected(x, y, c) + d, 0.0f, 1.0f);
+        }
+  });
   return a;
 }
 

@@ -109,14 +109,16 @@ void write_style(const Image<float>& style, const FeatureLayout& L, Image<int16_
 // elsewhere (drawn only there).
 Image<int32_t> warm_nnf(ImageView<const int32_t> given, int sw, int sh, int r, uint64_t seed) {
   Image<int32_t> out(given.width, given.height, 2);
-  for (int y = 0; y < given.height; ++y)
-    for (int x = 0; x < given.width; ++x) {
-      const int32_t sx = given(x, y, 0), sy = given(x, y, 1);
-      if (sx >= r && sx < sw - r && sy >= r && sy < sh - r)
-        out(x, y, 0) = sx, out(x, y, 1) = sy;
-      else
-        random_entry(x, y, sw, sh, r, seed, out.at(x, y));
-    }
+  parallel_rows(given.height, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < given.width; ++x) {
+        const int32_t sx = given(x, y, 0), sy = given(x, y, 1);
+        if (sx >= r && sx < sw - r && sy >= r && sy < sh - r)
+          out(x, y, 0) = sx, out(x, y, 1) = sy;
+        else
+          random_entry(x, y, sw, sh, r, seed, out.at(x, y));
+      }
+  });
   return out;
 }
 
@@ -358,12 +360,14 @@ Image<float> output_image(const Image<float>& style, const std::optional<Plane>&
 // The final field with -1 where the target is outside its (dilated) mask.
 Image<int32_t> active_nnf(const Image<int32_t>& nnf, const Image<uint8_t>& active, int tw, int th) {
   Image<int32_t> out(tw, th, 2);
-  for (int y = 0; y < th; ++y)
-    for (int x = 0; x < tw; ++x) {
-      const bool act = active.empty() || active(x, y);
-      out(x, y, 0) = act ? nnf(x, y, 0) : -1;
-      out(x, y, 1) = act ? nnf(x, y, 1) : -1;
-    }
+  parallel_rows(th, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < tw; ++x) {
+        const bool act = active.empty() || active(x, y);
+        out(x, y, 0) = act ? nnf(x, y, 0) : -1;
+        out(x, y, 1) = act ? nnf(x, y, 1) : -1;
+      }
+  });
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "core/error.h"
@@ -13,12 +14,12 @@ namespace emaki::synth {
 
 namespace {
 
-// Calls fn(x, y, value) for the first channel of every pixel, row by row.
+// Calls fn(x, y, value) for the first channel of every pixel of rows [y0, y1), row by row.
 template <typename Fn>
-void for_each_value(const Plane& plane, Fn&& fn) {
+void for_each_value(const Plane& plane, int y0, int y1, Fn&& fn) {
   std::visit(
       [&](const auto& v) {
-        for (int y = 0; y < v.height; ++y)
+        for (int y = y0; y < y1; ++y)
           for (int x = 0; x < v.width; ++x) fn(x, y, normalised(v.at(x, y)[0]));
       },
       plane);
@@ -30,7 +31,15 @@ void check_map(const GuidePair& g, int tw, int th) {
   if (plane_width(m) != tw || plane_height(m) != th)
     throw Error(name, fmt::format("weight map is {}x{} but the target is {}x{}", plane_width(m),
                                   plane_height(m), tw, th));
-  for_each_value(m, [&](int x, int y, float v) {
+  // Bands look for a bad value at once; the first in row order is then named.
+  std::atomic<bool> bad{false};
+  parallel_rows(th, 32, [&](int y0, int y1) {
+    for_each_value(m, y0, y1, [&](int, int, float v) {
+      if (!(v >= 0.0f && v <= 1.0f)) bad.store(true, std::memory_order_relaxed);
+    });
+  });
+  if (!bad) return;
+  for_each_value(m, 0, th, [&](int x, int y, float v) {
     if (!(v >= 0.0f && v <= 1.0f))
       throw Error(name,
                   fmt::format("weight map value {} at pixel ({}, {}) is not in [0, 1]", v, x, y));
@@ -90,7 +99,9 @@ Image<float> gather_weight_maps(const Inputs& in, int tw, int th) {
   int k = 0;
   for (const GuidePair& g : in.guides) {
     if (!g.weight_map) continue;
-    for_each_value(*g.weight_map, [&](int x, int y, float v) { out(x, y, k) = v; });
+    parallel_rows(th, 32, [&](int y0, int y1) {
+      for_each_value(*g.weight_map, y0, y1, [&](int x, int y, float v) { out(x, y, k) = v; });
+    });
     ++k;
   }
   return out;

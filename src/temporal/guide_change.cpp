@@ -73,11 +73,13 @@ void blur_pass(const Image<float>& in, const Image<float>& in_w, Image<float>& o
 Image<float> low_pass(ImageView<const float> image, float sigma, ImageView<const float> mask) {
   const int w = image.width, h = image.height, n = image.channels;
   Image<float> src(w, h, n), weight(w, h, 1);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      for (int c = 0; c < n; ++c) src(x, y, c) = image(x, y, c);
-      weight(x, y) = mask.empty() || mask(x, y, 0) > 0.0f ? 1.0f : 0.0f;
-    }
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < n; ++c) src(x, y, c) = image(x, y, c);
+        weight(x, y) = mask.empty() || mask(x, y, 0) > 0.0f ? 1.0f : 0.0f;
+      }
+  });
   if (sigma <= 0.0f) return src;
   const std::vector<float> k = gaussian_kernel(sigma);
   Image<float> rows, rows_w, out, out_w;
@@ -85,10 +87,12 @@ Image<float> low_pass(ImageView<const float> image, float sigma, ImageView<const
   // The column pass weighs each row result by how much of the mask it saw.
   blur_pass(rows, rows_w, out, out_w, k, false);
   if (!mask.empty())
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        if (weight(x, y) <= 0.0f)
-          for (int c = 0; c < n; ++c) out(x, y, c) = src(x, y, c);
+    parallel_rows(h, 32, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < w; ++x)
+          if (weight(x, y) <= 0.0f)
+            for (int c = 0; c < n; ++c) out(x, y, c) = src(x, y, c);
+    });
   return out;
 }
 
