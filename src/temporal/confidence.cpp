@@ -138,7 +138,8 @@ Image<float> foreign_share(const Image<int32_t>& nnf, const Image<uint8_t>& acti
       for (int x = 0; x < w; ++x) {
         const int ux0 = std::max(0, x - r), ux1 = std::min(w - 1, x + r);
         const int uy0 = std::max(0, y - r), uy1 = std::min(h - 1, y + r);
-        const float id = cur(x, y, 3);
+        // The pixel's own object, looked up once for its votes.
+        const Image<float>* own = shares.find(cur(x, y, 3));
         int votes = 0;
         float foreign = 0.0f;
         for (int uy = uy0; uy <= uy1; ++uy)
@@ -149,7 +150,7 @@ Image<float> foreign_share(const Image<int32_t>& nnf, const Image<uint8_t>& acti
             const int qx = m[0] + (x - ux), qy = m[1] + (y - uy);
             if (qx < 0 || qy < 0 || qx >= prev.width || qy >= prev.height) continue;
             ++votes;
-            foreign += 1.0f - shares.of(id, qx, qy);
+            foreign += 1.0f - (own ? (*own)(qx, qy) : 0.0f);
           }
         out(x, y) = votes ? foreign / float(votes) : 0.0f;
       }

@@ -49,11 +49,11 @@ struct IdShares {
   std::vector<float> ids;
   std::vector<Image<float>> share;  // parallel to ids
   bool empty() const { return radius < 0; }
-  // The share of the window around (x, y) showing id k (0 for an id not present).
-  float of(float k, int x, int y) const {
+  // The shares of id k, or null for an id not present (its share is 0 everywhere).
+  const Image<float>* find(float k) const {
     for (std::size_t i = 0; i < ids.size(); ++i)
-      if (ids[i] == k) return share[i](x, y);
-    return 0.0f;
+      if (ids[i] == k) return &share[i];
+    return nullptr;
   }
 };
 IdShares id_shares(ImageView<const float> previous, int radius);
