@@ -560,8 +560,8 @@ int main(int argc, char** argv) {
       Image<float> passes = source->passes(f);
       bench::update_disocclusion_age(age, passes.cview(), prev_passes.cview());
       const Image<uint8_t> disoccluded = bench::recently_disoccluded(age, passes.cview());
-      const Image<float> light = bench::light_guides(*layer, passes.cview()),
-                         prev_light = bench::light_guides(*layer, prev_passes.cview());
+      const Image<float> light = pipeline::change_guides(*layer, passes.cview()),
+                         prev_light = pipeline::change_guides(*layer, prev_passes.cview());
       const Image<uint8_t> held =
           light.empty() ? Image<uint8_t>{}
                         : bench::light_held(light, prev_light, passes.cview(), kLightTolerance);

@@ -14,10 +14,10 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
-#include <vector>
 
 #include "core/image.h"
 #include "pipeline/frames.h"
+#include "pipeline/temporal_guide.h"
 #include "render/passes.h"
 #include "temporal/confidence.h"
 
@@ -34,6 +34,12 @@ struct ToneTexture {
     return pixels ? 255.0 * (level_sum - reference_level_sum) / double(pixels) : 0.0;
   }
   double texture_kept() const { return reference_energy > 0 ? energy / reference_energy : 0.0; }
+  // One pixel: its level and high-pass value, temporal and frame by frame.
+  void add(float level, float reference_level, float high, float reference_high) {
+    level_sum += level, reference_level_sum += reference_level;
+    energy += double(high) * high, reference_energy += double(reference_high) * reference_high;
+    ++pixels;
+  }
 };
 
 // v minus the mean of the (2r+1)^2 box around it (clamped at the borders), channel 0.
@@ -66,9 +72,7 @@ inline void add_tone_texture(ToneTexture& t, const Image<float>& value,
     for (int x = 0; x < value.width(); ++x) {
       if (mask_channel >= 0 && raw(x, y, mask_channel) < 0.5f) continue;
       if (!select.empty() && !select(x, y)) continue;
-      t.level_sum += value(x, y, 0), t.reference_level_sum += reference(x, y, 0);
-      t.energy += double(hv(x, y)) * hv(x, y), t.reference_energy += double(hr(x, y)) * hr(x, y);
-      ++t.pixels;
+      t.add(value(x, y, 0), reference(x, y, 0), hv(x, y), hr(x, y));
     }
 }
 
@@ -83,37 +87,13 @@ inline void add_tone_texture_by_object(std::map<int, ToneTexture>& by_id, const 
       if (mask_channel >= 0 && raw(x, y, mask_channel) < 0.5f) continue;
       const float* p = passes.at(x, y);
       if (p[render::kAlpha] <= 0.5f) continue;
-      ToneTexture& t = by_id[int(std::lround(p[render::kObjectId]))];
-      t.level_sum += value(x, y, 0), t.reference_level_sum += reference(x, y, 0);
-      t.energy += double(hv(x, y)) * hv(x, y), t.reference_energy += double(hr(x, y)) * hr(x, y);
-      ++t.pixels;
+      by_id[int(std::lround(p[render::kObjectId]))].add(value(x, y, 0), reference(x, y, 0),
+                                                        hv(x, y), hr(x, y));
     }
-}
-
-// The layer's guides other than the normals, stacked (empty when it has none): what the light
-// changes.
-inline Image<float> light_guides(const pipeline::Layer& layer, ImageView<const float> passes) {
-  std::vector<Image<float>> parts;
-  int n = 0;
-  for (const pipeline::GuideSpec& g : layer.guides)
-    if (g.pass != "normal") {
-      parts.push_back(pipeline::extract_pass(passes, g.pass));
-      n += parts.back().channels();
-    }
-  if (n == 0) return {};
-  Image<float> out(passes.width, passes.height, n);
-  int c0 = 0;
-  for (const Image<float>& part : parts) {
-    for (int y = 0; y < passes.height; ++y)
-      for (int x = 0; x < passes.width; ++x)
-        for (int c = 0; c < part.channels(); ++c) out(x, y, c0 + c) = part(x, y, c);
-    c0 += part.channels();
-  }
-  return out;
 }
 
 // Where the light on the surface held between t-1 and t: each channel of the layer's guides
-// other than the normals (`current`, `previous`: stacked, values in [0, 1]) differs by at most
+// other than the normals (`current`, `previous`: pipeline::change_guides()) differs by at most
 // `tolerance` from its value at the pixel of t-1 the motion vectors point to. The flicker there
 // is the chain's own; elsewhere a moving light or shadow changes what the painting gives.
 inline Image<uint8_t> light_held(const Image<float>& current, const Image<float>& previous,

@@ -100,10 +100,6 @@ Image<int32_t> warm_field(const Layer& l, ImageView<const int32_t> previous,
   return warm;
 }
 
-namespace {
-
-// The layer's guides whose change along the advection means the painting's answer changed: all
-// but the normals, which turn with every rotation of the camera or the surface.
 Image<float> change_guides(const Layer& l, ImageView<const float> passes) {
   std::vector<Image<float>> parts;
   int channels = 0;
@@ -123,8 +119,6 @@ Image<float> change_guides(const Layer& l, ImageView<const float> passes) {
   }
   return out;
 }
-
-}  // namespace
 
 temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,

@@ -89,6 +89,11 @@ temporal::Advection advect_layer(const Layer& layer, ImageView<const float> pass
 Image<int32_t> carry_field(ImageView<const int32_t> previous,
                            const temporal::AdvectionField& field);
 
+// The layer's guides whose change along the advection means the painting's answer changed: all
+// but the normals, which turn with every rotation of the camera or the surface; stacked, each
+// value clamped to [0, 1]. Empty when the layer has none.
+Image<float> change_guides(const Layer& layer, ImageView<const float> passes);
+
 // carry_field() with the entries dropped where the temporal guide has no `confidence`: drawn
 // afresh (TemporalSpec::reseed), or, when `fresh` (the tone anchor's field at full size) is not
 // empty, taken from it.
