@@ -303,7 +303,8 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // size against the painting's), x=X (the warm start's sharp estimate; unset: 0, -1: from that
 // size as the sigma), u=U (temporal
 // uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed),
-// im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match).
+// im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match), fu=U,
+// fr=RADIUS, ft=TOLERANCE (the uniformity of flat areas, TemporalSpec::flat_uniformity, flat).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
   for (std::string m; std::getline(ss, m, ':');) {
@@ -332,6 +333,12 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.anchor_sigma = x;
     } else if (key == "ah") {
       l.temporal.anchor_holes = x != 0.0f;
+    } else if (key == "fu") {
+      l.temporal.flat_uniformity = x;
+    } else if (key == "fr") {
+      l.temporal.flat.area_radius = int(x);
+    } else if (key == "ft") {
+      l.temporal.flat.tolerance = x;
     } else if (key == "im") {
       l.temporal.ink_match = x;
     } else if (key == "is") {

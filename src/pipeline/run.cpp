@@ -207,14 +207,13 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   const bool chained = previous && previous_passes;
   const Anchor anchor =
       chained ? anchor_layer(p, frame, params, mask, temporal_pair, inputs) : Anchor{};
-  // With a temporal guide, B'adv already carries the previous frame's converged texture: one
-  // search-vote iteration at the finest level instead of two keeps flicker and the judge's
-  // style energy within their bars (measured on the example, docs/design/advection.md) and saves
-  // about a quarter of the time per frame.
+  // With a temporal guide, B'adv carries the previous frame's converged texture: one search-vote
+  // iteration at the finest level instead of two keeps flicker and the judge's style energy
+  // within their bars (docs/design/advection.md) and saves a quarter of the time per frame.
   Image<int32_t> warm;
+  Image<float> uniformity_map;
   if (chained) {
     params.finest_search_vote_iters = l.temporal.finest_iters;
-    params.uniformity = l.temporal.uniformity;
     const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
       warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor.nnf);
@@ -222,6 +221,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
       params.warm_sharp_estimate = p.sharpening.sharp_estimate;
       warm_schedule(l.synth, l.temporal, params);
     }
+    temporal_uniformity(l.temporal, targets, mask, params, uniformity_map);
   }
   synth::OutputRequest request;
   request.nnf = l.temporal.enabled && l.temporal.warm_start;

@@ -14,6 +14,7 @@
 #include "render/renderer.h"
 #include "scene/staging.h"
 #include "temporal/confidence.h"
+#include "temporal/flat_areas.h"
 
 namespace emaki::pipeline {
 
@@ -136,6 +137,12 @@ struct TemporalSpec {
   // a moving object at 3500); without it the chain settles into flat, textureless regions. 1000
   // is the middle measured on the example (docs/design/temporal-uniformity.md).
   float uniformity = 1000.0f;
+  // More uniformity inside the large flat areas of the layer's own guides at frame t
+  // (temporal::flat_areas, weighted by how surely a pixel lies in one): there the guides leave
+  // every fitting patch of the painting equally good and a chain without the term settles on a
+  // few of them, flat and off in tone. 0: none. Not in the shot file: a kind's default.
+  float flat_uniformity = 0.0f;
+  temporal::FlatAreaParams flat;
   // The main transfer at a temporal frame starts at the finest pyramid level from the previous
   // frame's field carried along the advection, instead of the whole pyramid from a random field
   // (docs/design/warm-start.md). Off: every frame runs the whole pyramid, as before it existed.

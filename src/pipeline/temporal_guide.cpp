@@ -34,6 +34,31 @@ TemporalSharpening temporal_sharpening(const TemporalSpec& t, int frame_width, i
           t.sharp_estimate >= 0.0f ? t.sharp_estimate : k};
 }
 
+void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>& guides,
+                         const Image<float>& mask, synth::Params& params, Image<float>& map) {
+  params.uniformity = t.uniformity;
+  if (!(t.flat_uniformity > 0.0f) || guides.empty()) return;
+  std::vector<ImageView<const float>> views;
+  for (const Image<float>& g : guides) views.push_back(g.cview());
+  map = temporal::flat_areas(views, mask.empty() ? ImageView<const float>{} : mask.cview(), t.flat);
+  // No flat area: no map and no term (the same result, bit for bit, without the cost).
+  bool any = false;
+  for (int y = 0; y < map.height() && !any; ++y)
+    any = std::any_of(map.row(y), map.row(y) + map.width(), [](float v) { return v > 0.0f; });
+  if (!any) {
+    map = {};
+    return;
+  }
+  const float total = t.uniformity + t.flat_uniformity;
+  parallel_rows(map.height(), 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < map.width(); ++x)
+        map(x, y) = std::min(1.0f, (t.uniformity + t.flat_uniformity * map(x, y)) / total);
+  });
+  params.uniformity = total;
+  params.uniformity_map = synth::Plane(map.cview());
+}
+
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
   if (const temporal::AdvectionField* f = find(l, frame)) return *f;

@@ -38,6 +38,12 @@ struct TemporalSharpening {
 TemporalSharpening temporal_sharpening(const TemporalSpec& t, int frame_width, int frame_height,
                                        int painting_width, int painting_height);
 
+// The main transfer's uniformity at a temporal frame: TemporalSpec::uniformity everywhere, plus
+// flat_uniformity inside the flat areas of the layer's target guides (`guides`, within `mask`).
+// Sets params.uniformity and, with flat_uniformity, params.uniformity_map, held by `map`.
+void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>& guides,
+                         const Image<float>& mask, synth::Params& params, Image<float>& map);
+
 // One frame's advection fields, shared by the layers that advect with the same guide, patch size
 // and seed: a field depends on neither a layer's value nor its mask (temporal::advection_field),
 // so the layers of a shot, which differ in those, match once per frame instead of once each.

@@ -211,6 +211,7 @@ struct PixelRefs {
   int32_t* n;
   float* e;
   const int16_t* t;
+  float occ_weight;  // PatchMatchLevel::uniformity_map at the pixel
 };
 
 // Tries source centre (cx, cy) for target pixel `px`; cur_occ is the occupancy cost of the
@@ -220,7 +221,7 @@ inline void try_candidate(const Sweep& S, Band& band, const PixelRefs& px, int c
   const PatchMatchLevel& L = S.L;
   int32_t* n = px.n;
   if (cx == n[0] && cy == n[1]) return;
-  const float new_occ = occupancy(S, band, cx, cy, mv);
+  const float new_occ = occupancy(S, band, cx, cy, mv) * px.occ_weight;
   float& e = *px.e;
   const float cur_cost = e + cur_occ;
   const float bound = cur_cost - new_occ;
@@ -236,7 +237,7 @@ inline void try_candidate(const Sweep& S, Band& band, const PixelRefs& px, int c
   if (!(new_err + new_occ < cur_cost)) return;
   if (S.occ_scale > 0.0f) {
     mv.to_x = cx, mv.to_y = cy;
-    cur_occ = occupancy(S, band, cx, cy, mv);
+    cur_occ = occupancy(S, band, cx, cy, mv) * px.occ_weight;
   }
   n[0] = cx;
   n[1] = cy;
@@ -270,6 +271,7 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
       prefetch_candidate(S, band, out[k][0], out[k][1]);
     }
   };
+  const bool occ_map = L.uniformity_map != nullptr && !L.uniformity_map->empty();
   // Outside a target mask nothing is drawn: the draws are keyed by pixel, so skipping them changes
   // no other pixel's, and a masked layer (a shadow, an outline) no longer pays for the whole frame.
   for (int y = ys; y != ye; y += q) {
@@ -280,9 +282,14 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
       if (next_x != xe && is_active(L, next_x, y)) draw(next_x, y, cand[cur ^ 1]);
       if (is_active(L, x, y)) {
         int32_t* n = L.nnf->at(x, y);
-        const PixelRefs px{x, y, n, L.err->at(x, y), L.tgt->at(x + L.border - r, y + L.border - r)};
+        const PixelRefs px{x,
+                           y,
+                           n,
+                           L.err->at(x, y),
+                           L.tgt->at(x + L.border - r, y + L.border - r),
+                           occ_map ? (*L.uniformity_map)(x, y) : 1.0f};
         PixelMove mv{n[0], n[1], n[0], n[1]};
-        float cur_occ = occupancy(S, band, n[0], n[1], mv);
+        float cur_occ = occupancy(S, band, n[0], n[1], mv) * px.occ_weight;
         // Propagation from the neighbours already visited in this sweep's direction.
         const int nx = x - q;
         if (nx >= 0 && nx < L.tw && is_active(L, nx, y)) {

@@ -49,6 +49,9 @@ struct PatchMatchLevel {
   // With weight maps: tw x th x groups, each target pixel's group weights (group 0, the
   // channels without a map, at kGroupWeightOne); nullptr or empty: the plain distance.
   const Image<int64_t>* group_weights = nullptr;
+  // tw x th multipliers of the uniformity term's cost at each target pixel; nullptr or empty:
+  // 1 everywhere.
+  const Image<float>* uniformity_map = nullptr;
 };
 
 struct PatchMatchConfig {

@@ -28,6 +28,7 @@ struct Level {
   Image<uint8_t> active;         // tw x th, or empty
   Image<float> weight_maps;      // tw x th x (groups - 1), with weight maps
   Image<int64_t> group_weights;  // tw x th x groups, made from them when the level starts
+  Image<float> uniformity_map;   // tw x th (Params::uniformity_map), or empty
 };
 
 FeatureLayout make_layout(const Inputs& in, const Params& p) {
@@ -180,6 +181,7 @@ Synthesizer::Synthesizer(const Inputs& in, const Params& params)
     }
     pad_replicate(f.tgt, border, ns, layout.channels);
     if (layout.groups > 1) f.weight_maps = gather_weight_maps(in, tw, th);
+    if (params.uniformity_map) f.uniformity_map = gather_map(*params.uniformity_map, tw, th);
     if (in.target_mask) {
       // Synthesize the mask dilated by the patch radius, so pixels at its edge get whole patches.
       Image<uint8_t> inside(tw, th, 1);
@@ -226,6 +228,7 @@ void build_coarse_levels(std::vector<Level>& pyr, const Plane& style, int sw, in
     pad_replicate(c.tgt, border, ns, layout.channels);
     if (!f.active.empty()) c.active = downsample_mask(f.active.cview());
     if (!f.weight_maps.empty()) c.weight_maps = downsample(f.weight_maps.cview());
+    if (!f.uniformity_map.empty()) c.uniformity_map = downsample(f.uniformity_map.cview());
   }
 }
 
@@ -248,8 +251,8 @@ struct Solve {
   }
 
   PatchMatchLevel pm_level(const Level& L) {
-    return {L.sw,   L.sh,      L.tw, L.th, border,          &L.src,
-            &L.tgt, &L.active, &nnf, &err, &L.group_weights};
+    return {L.sw,   L.sh,      L.tw, L.th, border,           &L.src,
+            &L.tgt, &L.active, &nnf, &err, &L.group_weights, &L.uniformity_map};
   }
   PatchMatchConfig pm_config(int patch) const {
     PatchMatchConfig cfg;

@@ -81,8 +81,12 @@ struct LevelSchedule {
 struct Params {
   float style_weight = -1.0f;  // >= 0, spread over the style channels; negative: 1
   float uniformity = 3500.0f;  // >= 0; 500..15000 sensible; 0 disables the uniformity term
-  int patch_size = 5;          // odd, >= 3
-  int pyramid_levels = -1;     // >= 1; -1: as many as fit (coarsest side >= 2 * patch_size + 1)
+  // Optional per-target-pixel multiplier of `uniformity`: first channel, the target's size,
+  // values in [0, 1] (0: the pixel's matches pay no occupancy cost); halved with the pyramid at
+  // coarser levels. Read only by the constructor.
+  std::optional<Plane> uniformity_map = {};
+  int patch_size = 5;       // odd, >= 3
+  int pyramid_levels = -1;  // >= 1; -1: as many as fit (coarsest side >= 2 * patch_size + 1)
   // -1: emaki's schedule (full search at coarse levels, leaner at the fine ones);
   // >= 0: that many at every level (EbSynth's behaviour; its defaults are 6 and 4).
   int search_vote_iters = -1;

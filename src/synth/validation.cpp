@@ -79,6 +79,7 @@ void validate(const Inputs& in, const Params& p) {
     throw Error(first_target, fmt::format("target {}x{} is smaller than the {}x{} patch", tw, th,
                                           p.patch_size, p.patch_size));
   check_weight_maps(in, p, tw, th);
+  if (p.uniformity_map) check_unit_map(*p.uniformity_map, "uniformity map", tw, th);
   const ImageView<const int32_t>& init = p.initial_nnf;
   if (!init.empty() && (init.width != tw || init.height != th || init.channels != 2))
     throw Error(F{"initial_nnf"}, fmt::format("is {}x{}x{}, the target {}x{}x2", init.width,

@@ -25,11 +25,11 @@ void for_each_value(const Plane& plane, int y0, int y1, Fn&& fn) {
       plane);
 }
 
-void check_map(const GuidePair& g, int tw, int th) {
-  const Plane& m = *g.weight_map;
-  const std::string& name = g.weight_map_name.empty() ? g.name : g.weight_map_name;
+}  // namespace
+
+void check_unit_map(const Plane& m, const std::string& name, int tw, int th) {
   if (plane_width(m) != tw || plane_height(m) != th)
-    throw Error(name, fmt::format("weight map is {}x{} but the target is {}x{}", plane_width(m),
+    throw Error(name, fmt::format("map is {}x{} but the target is {}x{}", plane_width(m),
                                   plane_height(m), tw, th));
   // Bands look for a bad value at once; the first in row order is then named.
   std::atomic<bool> bad{false};
@@ -41,19 +41,16 @@ void check_map(const GuidePair& g, int tw, int th) {
   if (!bad) return;
   for_each_value(m, 0, th, [&](int x, int y, float v) {
     if (!(v >= 0.0f && v <= 1.0f))
-      throw Error(name,
-                  fmt::format("weight map value {} at pixel ({}, {}) is not in [0, 1]", v, x, y));
+      throw Error(name, fmt::format("map value {} at pixel ({}, {}) is not in [0, 1]", v, x, y));
   });
 }
-
-}  // namespace
 
 void check_weight_maps(const Inputs& in, const Params& p, int tw, int th) {
   int maps = 0, channels = plane_channels(in.style);
   for (const GuidePair& g : in.guides) {
     channels += plane_channels(g.source);
     if (!g.weight_map) continue;
-    check_map(g, tw, th);
+    check_unit_map(*g.weight_map, g.weight_map_name.empty() ? g.name : g.weight_map_name, tw, th);
     ++maps;
   }
   if (maps == 0) return;
@@ -90,6 +87,14 @@ void assign_channel_groups(const Inputs& in, int patch_size, FeatureLayout& L) {
   for (int g = 0; g < L.groups; ++g)
     for (int i = 0; i < row_elems; ++i)
       if (L.group_of[i % L.channels] == g) L.group_masks[std::size_t(g) * row_elems + i] = -1;
+}
+
+Image<float> gather_map(const Plane& map, int tw, int th) {
+  Image<float> out(tw, th, 1);
+  parallel_rows(th, 32, [&](int y0, int y1) {
+    for_each_value(map, y0, y1, [&](int x, int y, float v) { out(x, y) = v; });
+  });
+  return out;
 }
 
 Image<float> gather_weight_maps(const Inputs& in, int tw, int th) {

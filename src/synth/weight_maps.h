@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -16,6 +17,13 @@ namespace emaki::synth {
 // values finite and in [0, 1]), and naming the guides or the patch size when the grouped sums
 // could leave 64 bits (more than kMaxWeightMaps maps; patch area x channels above 2^19).
 void check_weight_maps(const Inputs& in, const Params& params, int tw, int th);
+
+// Throws emaki::Error naming `name` when the map is not tw x th or a value of its first channel is
+// not in [0, 1] (a guide's weight map, Params::uniformity_map).
+void check_unit_map(const Plane& map, const std::string& name, int tw, int th);
+
+// The map's first channel, tw x th.
+Image<float> gather_map(const Plane& map, int tw, int th);
 
 // Puts each mapped guide's channels in a group of their own (group k for the k-th map, group 0
 // for the rest), makes the groups' masks for patch_size and turns err_scale into the grouped

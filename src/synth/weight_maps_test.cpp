@@ -1,6 +1,6 @@
 // Per-pixel guide weights: a map of ones changes nothing, a map of zeros drops the guide, a
 // constant map acts as the weight, the map decides where its guide counts, and results stay the
-// same for any thread count and either distance kernel.
+// same for any thread count and either distance kernel. The uniformity map likewise.
 #include "synth/weight_maps.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +10,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -214,6 +215,64 @@ TEST(WeightMaps, ValidateNamesTheMap) {
     in.guides.back().weight_map = Plane(ok.cview());
   }
   EXPECT_EQ(error_subject(in).rfind("guides", 0), 0u) << error_subject(in);
+}
+
+// Params::uniformity_map: ones change nothing, zeros switch the term off, any map gives the same
+// bits for any thread count, and a bad map is named.
+Result run_with(const Inputs& in, float uniformity, const Image<float>* map) {
+  Params p;
+  p.uniformity = uniformity;
+  if (map) p.uniformity_map = Plane(map->cview());
+  OutputRequest req;
+  req.nnf = true;
+  return synthesize(in, p, req);
+}
+
+TEST(UniformityMap, OnesAreNoMapAndZerosNoTerm) {
+  const TwoGuides t;
+  const Image<float> ones = constant(80, 60, 1.0f), zeros = constant(80, 60, 0.0f);
+  const Result plain = run_with(t.inputs(), 3500.0f, nullptr);
+  const Result with_ones = run_with(t.inputs(), 3500.0f, &ones);
+  EXPECT_TRUE(same_bits(plain.image, with_ones.image));
+  EXPECT_TRUE(same_nnf(plain.nnf, with_ones.nnf));
+  const Result off = run_with(t.inputs(), 0.0f, nullptr);
+  const Result with_zeros = run_with(t.inputs(), 3500.0f, &zeros);
+  EXPECT_TRUE(same_bits(off.image, with_zeros.image));
+  EXPECT_TRUE(same_nnf(off.nnf, with_zeros.nnf));
+  EXPECT_FALSE(same_nnf(plain.nnf, off.nnf));  // the term did count
+}
+
+TEST(UniformityMap, BitIdenticalForAnyThreadCount) {
+  const TwoGuides t;
+  const Image<float> map = noise(80, 60, 1, 41);
+  std::vector<Result> results;
+  for (int threads : {1, 2, 3}) {
+    const ScopedThreadCount count(threads);
+    results.push_back(run_with(t.inputs(), 3500.0f, &map));
+  }
+  for (std::size_t i = 1; i < results.size(); ++i) {
+    EXPECT_TRUE(same_bits(results[0].image, results[i].image)) << "run " << i;
+    EXPECT_TRUE(same_nnf(results[0].nnf, results[i].nnf)) << "run " << i;
+  }
+  EXPECT_FALSE(same_nnf(results[0].nnf, run_with(t.inputs(), 3500.0f, nullptr).nnf));
+}
+
+TEST(UniformityMap, ValidateNamesIt) {
+  const TwoGuides t;
+  Params p;
+  Image<float> bad = constant(80, 60, 0.5f);
+  bad(4, 5) = -0.5f;
+  p.uniformity_map = Plane(bad.cview());
+  try {
+    validate(t.inputs(), p);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.subject()), "uniformity map");
+    EXPECT_NE(std::string(e.what()).find("(4, 5)"), std::string::npos) << e.what();
+  }
+  const Image<float> small = constant(80, 59, 1.0f);
+  p.uniformity_map = Plane(small.cview());
+  EXPECT_THROW(validate(t.inputs(), p), Error);
 }
 
 }  // namespace
