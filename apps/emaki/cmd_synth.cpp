@@ -61,6 +61,8 @@ emaki options
                         centre; -1 outside the mask)
   --error-out FILE      write the per-pixel patch error (EXR, EbSynth units)
   --output-depth 8|16|float  output sample format. Default: that of the style image
+  --index K             also try each propagated candidate's K most similar exemplar patches
+                        (k-coherence sets of a per-painting index; 0..16). Default: 0 (off)
   --quiet               no summary line
   --help                this text
 )";

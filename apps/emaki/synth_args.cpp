@@ -179,6 +179,8 @@ bool parse_emaki_option(ArgCursor& in, SynthArgs& r) {
       throw Error(a, "must be 8, 16 or float (got '" + echo(r.depth) + "')");
   } else if (a == "--guide-weight-map") {
     parse_guide_weight_map(in);
+  } else if (a == "--index") {
+    r.params.index_k = parse_int_in(a, in.value(), 0, 16);
   } else if (a == "--quiet") {
     r.quiet = true;
   } else {

@@ -36,6 +36,19 @@ TEST(SynthArgs, EbSynthCommandLine) {
   EXPECT_TRUE(a.params.extra_pass_3x3);
 }
 
+TEST(SynthArgs, IndexSetsTheCoherenceSetSize) {
+  const std::vector<std::string> base{"-style", "s.png", "-guide", "a.png", "b.png"};
+  auto with = [&](const std::string& v) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), {"--index", v});
+    return a;
+  };
+  EXPECT_EQ(parse_synth_args(base).params.index_k, 0);
+  EXPECT_EQ(parse_synth_args(with("4")).params.index_k, 4);
+  EXPECT_NE(error_of(with("17")).find("--index"), std::string::npos);
+  EXPECT_NE(error_of(with("-1")).find("--index"), std::string::npos);
+}
+
 TEST(SynthArgs, ErrorsNameTheOption) {
   const std::vector<std::string> base{"-style", "s.png", "-guide", "a.png", "b.png"};
   struct Case {

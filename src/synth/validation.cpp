@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "synth/exemplar_index.h"
 #include "synth/planes.h"
 #include "synth/pyramid.h"
 #include "synth/synthesizer.h"
@@ -38,6 +39,8 @@ void validate(const Inputs& in, const Params& p) {
   if (!(p.warm_sharp_estimate >= 0.0f && p.warm_sharp_estimate <= 1.0f))
     throw Error(F{"warm_sharp_estimate"}, "must be between 0 and 1");
   if (p.finest_search_vote_iters < -1) throw Error(F{"finest_search_vote_iters"}, "must be >= 0");
+  if (p.index_k < 0 || p.index_k > kMaxIndexK)
+    throw Error(F{"index_k"}, fmt::format("must be in [0, {}] (got {})", kMaxIndexK, p.index_k));
 
   const int sw = plane_width(in.style), sh = plane_height(in.style);
   const int ns = plane_channels(in.style);
