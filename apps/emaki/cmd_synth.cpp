@@ -13,6 +13,7 @@
 #include <string>
 
 #include "apps/emaki/commands.h"
+#include "apps/emaki/index_cache.h"
 #include "apps/emaki/synth_args.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -61,6 +62,10 @@ emaki options
                         centre; -1 outside the mask)
   --error-out FILE      write the per-pixel patch error (EXR, EbSynth units)
   --output-depth 8|16|float  output sample format. Default: that of the style image
+  --index K             also try each propagated candidate's K most similar exemplar patches
+                        (k-coherence sets of a per-painting index; 0..16). Default: 0 (off)
+  --index-cache DIR     keep the index in DIR, one file per painting, guides, patch size and K,
+                        and reuse it (with --index)
   --quiet               no summary line
   --help                this text
 )";
@@ -177,6 +182,8 @@ int run_synth(const Args& argv) {
   synth::OutputRequest req;
   req.nnf = !args.nnf_out.empty();
   req.error = !args.error_out.empty();
+  const std::string index_path = args.index_cache.empty() ? "" : index_cache_path(args);
+  if (!index_path.empty()) params.index = load_cached_index(index_path, args.quiet);
   synth::Synthesizer synthesizer(ruled.inputs, params);
   // The guides are packed into the engine's features now; free them before the long part.
   ruled.release_guides();
@@ -193,6 +200,8 @@ int run_synth(const Args& argv) {
   const Image<float> out_img = ns == 1 ? synth::gray_to_rgb(res.image) : std::move(res.image);
   io::write_image(args.output, out_img.cview(), wo);
   write_field_and_error(args, res);
+  if (!index_path.empty() && res.index && res.index != params.index)
+    store_cached_index(index_path, *res.index);
   if (!args.quiet) {
     using seconds = std::chrono::duration<double>;
     std::fprintf(stderr,

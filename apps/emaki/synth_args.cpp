@@ -179,6 +179,10 @@ bool parse_emaki_option(ArgCursor& in, SynthArgs& r) {
       throw Error(a, "must be 8, 16 or float (got '" + echo(r.depth) + "')");
   } else if (a == "--guide-weight-map") {
     parse_guide_weight_map(in);
+  } else if (a == "--index") {
+    r.params.index_k = parse_int_in(a, in.value(), 0, 16);
+  } else if (a == "--index-cache") {
+    r.index_cache = in.value();
   } else if (a == "--quiet") {
     r.quiet = true;
   } else {
@@ -204,6 +208,8 @@ SynthArgs parse_synth_args(const std::vector<std::string>& args) {
   }
   if (r.style_path.empty()) throw Error("-style", "is required (the style exemplar)");
   if (r.guides.empty()) throw Error("-guide", "at least one guide pair is required");
+  if (!r.index_cache.empty() && r.params.index_k == 0)
+    throw Error("--index-cache", "needs --index K (K > 0)");
   for (const auto& [n, file] : in.weight_maps) {
     if (n > int(r.guides.size()))
       throw Error("--guide-weight-map",

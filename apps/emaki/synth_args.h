@@ -25,6 +25,7 @@ struct SynthArgs {
   synth::Params params;
   int threads = 0;
   bool quiet = false;
+  std::string index_cache;  // --index-cache DIR, or empty
 };
 
 // Bounds on counts a command line may ask for (the same as Python's, see ebsynth_rules.h).

@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
+#include "apps/emaki/index_cache.h"
 #include "core/error.h"
 
 namespace emaki::app {
@@ -34,6 +36,45 @@ TEST(SynthArgs, EbSynthCommandLine) {
   EXPECT_EQ(a.params.patch_size, 7);
   EXPECT_EQ(a.params.uniformity, 1000.0f);
   EXPECT_TRUE(a.params.extra_pass_3x3);
+}
+
+TEST(SynthArgs, IndexSetsTheCoherenceSetSize) {
+  const std::vector<std::string> base{"-style", "s.png", "-guide", "a.png", "b.png"};
+  auto with = [&](const std::string& v) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), {"--index", v});
+    return a;
+  };
+  EXPECT_EQ(parse_synth_args(base).params.index_k, 0);
+  EXPECT_EQ(parse_synth_args(with("4")).params.index_k, 4);
+  EXPECT_NE(error_of(with("17")).find("--index"), std::string::npos);
+  EXPECT_NE(error_of(with("-1")).find("--index"), std::string::npos);
+}
+
+TEST(IndexCache, StoresLoadsAndRejectsADamagedFile) {
+  const std::string dir = ::testing::TempDir() + "emaki_index_cache_test";
+  std::filesystem::remove_all(dir);
+  SynthArgs a = parse_synth_args(
+      {"-style", "s.png", "-guide", "a.png", "b.png", "--index", "2", "--index-cache", dir});
+  const std::string path = index_cache_path(a);
+  EXPECT_EQ(path.rfind(dir, 0), 0u);
+  a.params.index_k = 3;
+  EXPECT_NE(index_cache_path(a), path);               // k is part of the name
+  EXPECT_EQ(load_cached_index(path, true), nullptr);  // no file yet
+  synth::ExemplarIndex index;
+  index.patch_size = 5, index.k = 2, index.features_digest = 42;
+  index.levels.push_back({3, 2, 2, {-1, 0, 1, 2, 3, 4, 5, -1, -1, -1, 0, 1}});
+  store_cached_index(path, index);
+  const auto back = load_cached_index(path, true);
+  ASSERT_NE(back, nullptr);
+  EXPECT_EQ(back->features_digest, 42u);
+  EXPECT_EQ(back->levels[0].entries, index.levels[0].entries);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 1);
+  EXPECT_EQ(load_cached_index(path, true), nullptr);
+  EXPECT_NE(error_of({"-style", "s.png", "-guide", "a.png", "b.png", "--index-cache", dir})
+                .find("--index-cache"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SynthArgs, ErrorsNameTheOption) {

@@ -214,6 +214,11 @@ struct PixelRefs {
   float occ_weight;  // PatchMatchLevel::uniformity_map at the pixel
 };
 
+// PatchMatchLevel::uniformity_map at target pixel (x, y), 1 without one.
+inline float occupancy_weight(const PatchMatchLevel& L, int x, int y) {
+  return L.uniformity_map && !L.uniformity_map->empty() ? (*L.uniformity_map)(x, y) : 1.0f;
+}
+
 // Tries source centre (cx, cy) for target pixel `px`; cur_occ is the occupancy cost of the
 // pixel's current match. A taken candidate becomes the match and the end of `mv`.
 inline void try_candidate(const Sweep& S, Band& band, const PixelRefs& px, int cx, int cy,
@@ -244,6 +249,16 @@ inline void try_candidate(const Sweep& S, Band& band, const PixelRefs& px, int c
   e = new_err;
 }
 
+// Tries the k-coherence set of source centre (bx, by) (PatchMatchConfig::coherence), which
+// only the source decides: no band writes it.
+inline void try_set(const Sweep& S, Band& band, const PixelRefs& px, int bx, int by, PixelMove& mv,
+                    float& cur_occ) {
+  const CoherenceSets& sets = *S.C.coherence;
+  const int32_t* set = sets.at(bx, by);
+  for (int i = 0; i < sets.k && set[i] >= 0; ++i)
+    try_candidate(S, band, px, set[i] % S.L.sw, set[i] / S.L.sw, mv, cur_occ);
+}
+
 void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
   const PatchMatchLevel& L = S.L;
   const bool forward = (iter % 2) == 0;
@@ -271,7 +286,7 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
       prefetch_candidate(S, band, out[k][0], out[k][1]);
     }
   };
-  const bool occ_map = L.uniformity_map != nullptr && !L.uniformity_map->empty();
+  const bool kcoh = S.C.coherence != nullptr;
   // Outside a target mask nothing is drawn: the draws are keyed by pixel, so skipping them changes
   // no other pixel's, and a masked layer (a shadow, an outline) no longer pays for the whole frame.
   for (int y = ys; y != ye; y += q) {
@@ -287,7 +302,7 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
                            n,
                            L.err->at(x, y),
                            L.tgt->at(x + L.border - r, y + L.border - r),
-                           occ_map ? (*L.uniformity_map)(x, y) : 1.0f};
+                           occupancy_weight(L, x, y)};
         PixelMove mv{n[0], n[1], n[0], n[1]};
         float cur_occ = occupancy(S, band, n[0], n[1], mv) * px.occ_weight;
         // Propagation from the neighbours already visited in this sweep's direction.
@@ -295,14 +310,20 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
         if (nx >= 0 && nx < L.tw && is_active(L, nx, y)) {
           const int32_t* m = L.nnf->at(nx, y);
           const int cx = m[0] + q;
-          if (cx >= lo_x && cx <= hi_x) try_candidate(S, band, px, cx, m[1], mv, cur_occ);
+          if (cx >= lo_x && cx <= hi_x) {
+            try_candidate(S, band, px, cx, m[1], mv, cur_occ);
+            if (kcoh) try_set(S, band, px, cx, m[1], mv, cur_occ);
+          }
         }
         const int ny = y - q;
         if (ny >= 0 && ny < L.th && is_active(L, x, ny)) {
           // Across the band edge the neighbouring band is not being swept in this round.
           const int32_t* m = L.nnf->at(x, ny);
           const int cy = m[1] + q;
-          if (cy >= lo_y && cy <= hi_y) try_candidate(S, band, px, m[0], cy, mv, cur_occ);
+          if (cy >= lo_y && cy <= hi_y) {
+            try_candidate(S, band, px, m[0], cy, mv, cur_occ);
+            if (kcoh) try_set(S, band, px, m[0], cy, mv, cur_occ);
+          }
         }
         for (int k = 0; k < num_radii; ++k)
           try_candidate(S, band, px, cand[cur][k][0], cand[cur][k][1], mv, cur_occ);
@@ -379,6 +400,7 @@ void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
 void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   CHECK(C.ssd != nullptr);
   CHECK_EQ(C.patch_size % 2, 1);
+  if (C.coherence) CHECK(C.coherence->width == L.sw && C.coherence->height == L.sh);
   const int p = C.patch_size;
   int64_t active_count = 0;
   for (int y = 0; y < L.th; ++y)

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "synth/exemplar_index.h"
 #include "synth/patch_distance.h"
 
 namespace emaki::synth {
@@ -71,6 +72,9 @@ struct PatchMatchConfig {
   // Called on the calling thread before each sweep, when set; it may throw to stop the run
   // (cancellation), and otherwise changes nothing.
   const std::function<void()>* before_sweep = nullptr;
+  // The level's k-coherence sets (exemplar_index.h, the source's size and this patch size), or
+  // nullptr: each propagated centre's set is tried after it.
+  const CoherenceSets* coherence = nullptr;
 };
 
 // The distance between the target patch centred at (x, y) (top-left element t) and a source

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "synth/exemplar_index.h"
 #include "synth/patch_match.h"
 #include "synth/planes.h"
 #include "synth/pyramid.h"
@@ -242,6 +243,7 @@ struct Solve {
   PatchSsdFn ssd;
   // Cancellation (Params::cancel), polled on this thread before each level and each sweep.
   std::function<void()> poll;
+  const ExemplarIndex* index = nullptr;  // with Params::index_k
   Image<int32_t> nnf;  // holds the warm start's field (if any) until the level starts
   Image<float> err;
   Image<float> style;
@@ -319,6 +321,7 @@ struct Solve {
     cfg.iterations = sch.patch_match_iters;
     cfg.max_search_radius = sch.max_search_radius;
     cfg.before_sweep = &poll;
+    if (index != nullptr && patch == index->patch_size) cfg.coherence = &index->levels[l];
     for (int it = 0; it < sch.search_vote_iters; ++it) {
       cfg.seed = hash_key(params.seed, uint64_t(step), uint64_t(it), uint64_t(patch));
       compute_errors(pm, cfg);
@@ -374,6 +377,29 @@ Image<int32_t> active_nnf(const Image<int32_t>& nnf, const Image<uint8_t>& activ
   return out;
 }
 
+// The index of the levels' source features: `given` when it was built from the same ones with
+// the same patch size and k, else built coarse to fine (each level started from the coarser one's
+// sets). Its seed is fixed, so one painting has one index whatever the run's seed.
+std::shared_ptr<const ExemplarIndex> level_index(
+    const std::vector<Level>& pyr, const Params& params,
+    const std::shared_ptr<const ExemplarIndex>& given) {
+  std::vector<const Image<int16_t>*> features;
+  for (const Level& L : pyr) features.push_back(&L.src);
+  const uint64_t digest = features_digest(features);
+  if (given && given->features_digest == digest && given->patch_size == params.patch_size &&
+      given->k == params.index_k && given->levels.size() == pyr.size())
+    return given;
+  auto index = std::make_shared<ExemplarIndex>();
+  index->patch_size = params.patch_size, index->k = params.index_k;
+  index->features_digest = digest;
+  index->levels.resize(pyr.size());
+  for (std::size_t l = pyr.size(); l-- > 0;)
+    index->levels[l] = build_coherence_sets(pyr[l].src, params.patch_size, params.index_k,
+                                            l + 1 < pyr.size() ? &index->levels[l + 1] : nullptr,
+                                            best_patch_ssd(), hash_key(0x1de, l));
+  return index;
+}
+
 }  // namespace
 
 Result Synthesizer::run(const OutputRequest& request) {
@@ -389,7 +415,10 @@ Result Synthesizer::run(const OutputRequest& request) {
   // so that the caller has already freed the guide images.
   build_coarse_levels(pyr, st.style, st.sw, st.sh, st.layout, st.border);
 
-  Solve solve{params, st.layout, st.style, st.border, best_patch_ssd(), {}, {}, {}, {}};
+  Solve solve{params, st.layout, st.style, st.border, best_patch_ssd(), {}, nullptr, {}, {}, {}};
+  std::shared_ptr<const ExemplarIndex> index;
+  if (params.index_k > 0) index = level_index(pyr, params, params.index);
+  solve.index = index.get();
   solve.nnf = std::move(st.initial_nnf);
   solve.poll = [&params] {
     if (params.cancel && params.cancel()) throw Cancelled();
@@ -409,6 +438,7 @@ Result Synthesizer::run(const OutputRequest& request) {
   Result res;
   res.pyramid_levels = levels;
   res.schedule = schedule;
+  res.index = std::move(index);
   const Level& F = pyr[0];
   res.image = output_image(solve.style, st.mask, st.layout.style_channels, st.tw, st.th);
   if (request.nnf) res.nnf = active_nnf(solve.nnf, F.active, st.tw, st.th);

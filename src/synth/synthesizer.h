@@ -33,6 +33,8 @@
 
 namespace emaki::synth {
 
+struct ExemplarIndex;  // exemplar_index.h
+
 // A read-only input plane: 8-bit and 16-bit samples mean [0, 1]; float samples are taken as-is.
 using Plane =
     std::variant<ImageView<const uint8_t>, ImageView<const uint16_t>, ImageView<const float>>;
@@ -110,6 +112,13 @@ struct Params {
   // blurs; between, that mix. Without a warm start it does nothing.
   float warm_sharp_estimate = 0.0f;
   bool extra_pass_3x3 = false;  // a final polishing pass with 3x3 patches, no uniformity
+  // 0..16: PatchMatch also tries the k-coherence sets of its propagated candidates, from a
+  // per-painting index (exemplar_index.h) of this many sets per source patch; 0: no index.
+  int index_k = 0;
+  // Optional prebuilt index (Result::index of an earlier run on the same painting, guides and
+  // patch size): used when it was built from the same source features with the same k, else
+  // built anew.
+  std::shared_ptr<const ExemplarIndex> index = {};
   VoteMode vote_mode = VoteMode::kWeighted;
   uint64_t seed = 1;
   // Optional progress callback: (level, levels).
@@ -146,6 +155,7 @@ struct Result {
   Image<float> error;  // when requested; 0 outside the mask
   int pyramid_levels = 0;
   std::vector<LevelSchedule> schedule;
+  std::shared_ptr<const ExemplarIndex> index;  // the index used (Params::index_k > 0)
 };
 
 // Checks the inputs (sizes, channel counts, finite values, parameter ranges) and throws
