@@ -23,10 +23,11 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // the shadow's edge blurs, and where a moving light uncovered ground the layer came out
       // 13 levels of 255 lighter than frame by frame (docs/design/long-shots.md).
       d.temporal_anchor = 1;
-      // Large flat areas (a wall in shadow) went flat and grey without the uniformity term; the
-      // term where the guides are flat over 129x129 pixels gives them their texture back and
-      // leaves smaller shadows, which flickered with it, as they were (docs/design/long-shots.md).
-      d.temporal_flat_uniformity = 500.0f;
+      // Large flat areas (a wall in shadow) went flat, grey and darker without the uniformity
+      // term; the first frame's term where the guides are flat over 129x129 pixels gives them
+      // their texture and tone back and leaves smaller shadows, which flickered with it, as they
+      // were (docs/design/long-shots.md).
+      d.temporal_flat_uniformity = true;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};

@@ -106,9 +106,9 @@ struct KindDefaults {
   float temporal_uniformity = 1000.0f;
   // The tone anchor's halvings (pipeline::TemporalSpec::anchor; not a shot-file key).
   int temporal_anchor = 2;
-  // The uniformity added inside large flat areas of the guides (TemporalSpec::flat_uniformity;
-  // not a shot-file key).
-  float temporal_flat_uniformity = 0.0f;
+  // Whether temporal frames add the layer's own `uniformity` (the first frame's) inside large
+  // flat areas of its guides (TemporalSpec::flat_uniformity; not a shot-file key).
+  bool temporal_flat_uniformity = false;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

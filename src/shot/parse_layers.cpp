@@ -216,7 +216,7 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   l.temporal.confidence = r.boolean("temporal_confidence", l.temporal.confidence);
   l.temporal.uniformity = r.real("temporal_uniformity", d.temporal_uniformity);
   l.temporal.anchor = d.temporal_anchor;
-  l.temporal.flat_uniformity = d.temporal_flat_uniformity;
+  l.temporal.flat_uniformity = d.temporal_flat_uniformity ? l.synth.uniformity : 0.0f;
   l.temporal.warm_start = r.boolean("temporal_warm_start", l.temporal.warm_start);
   l.temporal.keep_every_field =
       r.choice("temporal_fields", l.temporal.keep_every_field, kKeptFields);

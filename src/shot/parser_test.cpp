@@ -73,6 +73,16 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_FLOAT_EQ(s.layers[1].temporal.uniformity, 0.0f);
   EXPECT_FLOAT_EQ(s.layers[2].temporal.weight, 0.0f);
   EXPECT_FLOAT_EQ(s.layers[2].temporal.uniformity, 0.0f);
+  // The shadow adds its first frame's uniformity inside large flat areas of its guides.
+  EXPECT_FLOAT_EQ(s.layers[2].temporal.flat_uniformity, 3500.0f);
+  EXPECT_FLOAT_EQ(s.layers[1].temporal.flat_uniformity, 0.0f);
+  EXPECT_FLOAT_EQ(s.layers[0].temporal.flat_uniformity, 0.0f);
+  EXPECT_FLOAT_EQ(parse_shot(minimal("[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"
+                                     "uniformity = 2000\n"),
+                             "/tmp/shot.toml")
+                      .layers[0]
+                      .temporal.flat_uniformity,
+                  2000.0f);
   EXPECT_EQ(s.layers[2].look.blend, composite::BlendMode::kMultiply);
   EXPECT_EQ(s.layers[2].guides[1].pass, "shadow");
   EXPECT_TRUE(s.layers[0].single_colour);
