@@ -8,7 +8,9 @@
 // split of those frames by layer follows (a layer's time includes its advection, and the first
 // layer's the frame's rendering; "compositing" runs from the composite's start to the next frame).
 // With --digest it also prints a digest of every layer frame and composited frame (equal
-// digests, equal results); computing it adds to the frames' times.
+// digests, equal results); computing it adds to the frames' times. Like `emaki`, it starts
+// itself again with huge pages where the kernel takes advice (apps/emaki/huge_pages.h;
+// GLIBC_TUNABLES=glibc.malloc.hugetlb=0 measures without them).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/emaki/huge_pages.h"
 #include "core/parallel.h"
 #include "core/performance.h"
 #include "memory_store.h"
@@ -24,6 +27,7 @@
 #include "shot/inputs.h"
 
 int main(int argc, char** argv) {
+  emaki::app::restart_with_huge_pages(argv);                      // as `emaki` does
   emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   using namespace emaki;
   int width = 1920, height = 1080, frames = 3, threads = 0;
