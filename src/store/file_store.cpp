@@ -15,6 +15,7 @@
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "store/field_file.h"
+#include "store/kept_fields.h"
 #include "store/qa_maps.h"
 #include "store/settings_manifests.h"
 
@@ -49,6 +50,9 @@ std::string OutputPaths::contact_sheet() const {
 }
 std::string OutputPaths::passes_exr(int frame) const {
   return fmt::format("{}/passes/frame_{:04d}.exr", folder, frame);
+}
+std::string OutputPaths::passes_fields(int frame) const {
+  return fmt::format("{}/passes/advection_{:04d}.field", folder, frame);
 }
 
 namespace {
@@ -92,6 +96,12 @@ void remove_frames(const fs::path& dir, const std::string& prefix,
 bool is_layer_file(const std::string& name, const std::string& layer) {
   return is_frame_name(name, layer + "_", {".png", ".exr"}) ||
          is_frame_name(name, "." + layer + "_", {".nnf"});
+}
+
+// The pass cache's frames and the advection fields beside them.
+void remove_pass_cache(const std::string& dir) {
+  remove_frames(dir, "frame_", {".exr"});
+  remove_frames(dir, "advection_", {".field"});
 }
 
 void remove_layer_frames(const fs::path& dir, const std::string& layer) {
@@ -178,7 +188,8 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
   std::error_code ec;
   if (fs::is_directory(cache, ec)) {
     clean_up(cache, [](const std::string& t) {
-      return t == kManifest || is_frame_name(t, "frame_", {".exr"});
+      return t == kManifest || is_frame_name(t, "frame_", {".exr"}) ||
+             is_frame_name(t, "advection_", {".field"});
     });
   }
   passes_ = manifested(cache.string(), passes_manifest(shot), "frame_", {".exr"});
@@ -229,8 +240,7 @@ void FileStore::prepare() {
   });
   if (shot_.source.kind == pipeline::SourceKind::kScene) {
     make_folder(root / "passes");
-    make_current(passes_, (root / "passes").string(),
-                 [](const std::string& dir) { remove_frames(dir, "frame_", {".exr"}); });
+    make_current(passes_, (root / "passes").string(), remove_pass_cache);
   }
 }
 
@@ -248,13 +258,25 @@ void FileStore::write_passes(int frame, ImageView<const float> passes) {
   CHECK(access_ != StoreAccess::kInspect);
   const fs::path dir = fs::path(paths_.folder) / "passes";
   make_folder(dir);
-  make_current(passes_, dir.string(),
-               [](const std::string& d) { remove_frames(d, "frame_", {".exr"}); });
+  make_current(passes_, dir.string(), remove_pass_cache);
   WriteOptions exr;
   exr.format = SampleFormat::kFloat;  // bit for bit: every task reads the same floats
   exr.channel_names = render::channel_names();
   exr.compression = kIntermediateCompression;
   write_image(paths_.passes_exr(frame), passes, exr);
+}
+
+void FileStore::write_kept_fields(int frame, const std::vector<pipeline::KeptField>& fields) {
+  CHECK(access_ != StoreAccess::kInspect);
+  const fs::path dir = fs::path(paths_.folder) / "passes";
+  make_folder(dir);
+  make_current(passes_, dir.string(), remove_pass_cache);
+  const std::string path = paths_.passes_fields(frame);
+  const std::string bytes =
+      encode_kept_fields(frame, shot_.source.width, shot_.source.height, fields);
+  TempFile tmp(path, path);
+  tmp.write(bytes.data(), bytes.size());
+  tmp.commit();
 }
 
 FileStore::~FileStore() = default;
@@ -445,7 +467,12 @@ class CachedFrames : public pipeline::FrameSource {
       : paths_{shot.outputs.folder},
         width_(shot.source.width),
         height_(shot.source.height),
-        inner_(std::move(inner)) {}
+        inner_(std::move(inner)) {
+    // One field per temporal layer at most, 12 bytes a pixel and a 16-byte key each.
+    std::uintmax_t layers = 0;
+    for (const pipeline::Layer& l : shot.layers) layers += l.temporal.enabled ? 1 : 0;
+    max_fields_bytes_ = 40 + layers * (16 + 12 * std::uintmax_t(width_) * std::uintmax_t(height_));
+  }
   // A cached frame that is missing, cut short or unreadable is rendered instead (the cache holds
   // exactly what rendering gives): a damaged cache never stops a run, `--force` or not.
   // The file is opened once: checked whole and decoded through the same open.
@@ -465,9 +492,25 @@ class CachedFrames : public pipeline::FrameSource {
                                     width_, height_, kRedoHint));
     return img;
   }
+  // A file that is missing, cut short or damaged gives none: the layers compute theirs.
+  std::vector<pipeline::KeptField> kept_fields(int frame) const override {
+    const std::string path = paths_.passes_fields(frame);
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return {};
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > max_fields_bytes_) return {};
+    std::string bytes(std::size_t(size), '\0');
+    std::ifstream in(path, std::ios::binary);
+    // One byte more than the size said: a file that grew meanwhile is not read.
+    if (!in.read(bytes.data(), std::streamsize(size)) ||
+        in.peek() != std::ifstream::traits_type::eof())
+      return {};
+    return decode_kept_fields(bytes.data(), bytes.size(), frame, width_, height_);
+  }
 
  private:
   OutputPaths paths_;
+  std::uintmax_t max_fields_bytes_ = 0;  // a file larger than the fields of every layer: not read
   int width_, height_;
   std::unique_ptr<pipeline::FrameSource> inner_;
 };
