@@ -1,6 +1,10 @@
 #include "store/file_store.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -467,12 +471,7 @@ class CachedFrames : public pipeline::FrameSource {
       : paths_{shot.outputs.folder},
         width_(shot.source.width),
         height_(shot.source.height),
-        inner_(std::move(inner)) {
-    // One field per temporal layer at most, 12 bytes a pixel and a 16-byte key each.
-    std::uintmax_t layers = 0;
-    for (const pipeline::Layer& l : shot.layers) layers += l.temporal.enabled ? 1 : 0;
-    max_fields_bytes_ = 40 + layers * (16 + 12 * std::uintmax_t(width_) * std::uintmax_t(height_));
-  }
+        inner_(std::move(inner)) {}
   // A cached frame that is missing, cut short or unreadable is rendered instead (the cache holds
   // exactly what rendering gives): a damaged cache never stops a run, `--force` or not.
   // The file is opened once: checked whole and decoded through the same open.
@@ -492,25 +491,26 @@ class CachedFrames : public pipeline::FrameSource {
                                     width_, height_, kRedoHint));
     return img;
   }
-  // A file that is missing, cut short or damaged gives none: the layers compute theirs.
+  // A file that is missing, cut short or damaged gives none: the layers compute theirs. It is
+  // mapped, not read: nothing is allocated for what a file claims before it is checked.
   std::vector<pipeline::KeptField> kept_fields(int frame) const override {
     const std::string path = paths_.passes_fields(frame);
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) return {};
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec || size > max_fields_bytes_) return {};
-    std::string bytes(std::size_t(size), '\0');
-    std::ifstream in(path, std::ios::binary);
-    // One byte more than the size said: a file that grew meanwhile is not read.
-    if (!in.read(bytes.data(), std::streamsize(size)) ||
-        in.peek() != std::ifstream::traits_type::eof())
-      return {};
-    return decode_kept_fields(bytes.data(), bytes.size(), frame, width_, height_);
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return {};
+    struct stat st {};
+    void* block = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0
+                      ? ::mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0)
+                      : MAP_FAILED;
+    ::close(fd);
+    if (block == MAP_FAILED) return {};
+    std::vector<pipeline::KeptField> fields =
+        decode_kept_fields(block, std::size_t(st.st_size), frame, width_, height_);
+    ::munmap(block, std::size_t(st.st_size));
+    return fields;
   }
 
  private:
   OutputPaths paths_;
-  std::uintmax_t max_fields_bytes_ = 0;  // a file larger than the fields of every layer: not read
   int width_, height_;
   std::unique_ptr<pipeline::FrameSource> inner_;
 };
