@@ -150,6 +150,13 @@ void prepare(const pipeline::Shot& shot, const Request& request) {
   keep_references(shot, exemplars, rendered);
 }
 
+namespace {
+
+// The most object ids whose shares a kept advection field carries (store/kept_fields.h).
+constexpr std::size_t kKeptShareIds = 4;
+
+}  // namespace
+
 int render_passes(const pipeline::Shot& shot, const Request& request) {
   pipeline::check_run_options(shot, run_options(request));
   if (shot.source.kind != pipeline::SourceKind::kScene) return 0;
@@ -174,8 +181,13 @@ int render_passes(const pipeline::Shot& shot, const Request& request) {
     Image<float> passes = frames->passes(f);
     if (advects && f > shot.source.first_frame) {
       if (!previous) previous = frames->passes(f - 1);
-      store.write_kept_fields(
-          f, pipeline::advection_fields(shot, previous->cview(), passes.cview(), f));
+      std::vector<pipeline::KeptField> fields =
+          pipeline::advection_fields(shot, previous->cview(), passes.cview(), f);
+      // The id shares are a float plane per object id: with many objects they would outweigh the
+      // frame's passes on disk, and the layers make them again in a few ms a frame.
+      for (pipeline::KeptField& k : fields)
+        if (k.field.shares.ids.size() > kKeptShareIds) k.field.shares = {};
+      store.write_kept_fields(f, fields);
     }
     store.write_passes(f, passes.cview());
     previous = std::move(passes);
