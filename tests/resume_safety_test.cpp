@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -16,6 +17,7 @@
 #include "cli_run.h"
 #include "core/image.h"
 #include "io/image_io.h"
+#include "tests/file_bytes.h"
 #include "tests/small_disk.h"
 #include "tests/small_painting.h"
 
@@ -144,6 +146,44 @@ TEST_F(ResumeSafety, TruncatedCacheAndLayerFilesAreReplacedByRunForce) {
   EXPECT_NE(r.err.find("6 layer-frames synthesized"), std::string::npos) << r.err;
   expect_ok(emaki("task passes shot.toml --frames 0-2"));
   EXPECT_GT(expect_all_readable(dir_ / "shot/out"), 10);
+}
+
+// The advection fields the passes tasks keep (passes/advection_NNNN.field, one file per frame
+// after the first) give the layer tasks a run's frames; a field file cut short or with a byte
+// changed is not read (the layer task computes its fields) and gives the same frames.
+TEST_F(ResumeSafety, LayerTasksMakeARunsFramesFromKeptOrDamagedFields) {
+  expect_ok(emaki("run shot.toml"));
+  write_shot("farm");
+  expect_ok(emaki("task prepare shot.toml"));
+  expect_ok(emaki("task passes shot.toml --frames 0-1"));
+  expect_ok(emaki("task passes shot.toml --frames 2-2"));
+  EXPECT_FALSE(fs::exists(p("shot/farm/passes/advection_0000.field")));
+  EXPECT_TRUE(fs::exists(p("shot/farm/passes/advection_0001.field")));
+  EXPECT_TRUE(fs::exists(p("shot/farm/passes/advection_0002.field")));
+  const auto same_as_run = [&] {
+    for (const char* layer : {"base", "outline"}) {
+      std::string task = "task layer shot.toml --layer ";
+      task += layer;
+      expect_ok(emaki(task));
+      for (int f = 0; f <= 2; ++f) {
+        char name[64];
+        std::snprintf(name, sizeof name, "/layers/%s/%s_%04d.exr", layer, layer, f);
+        EXPECT_EQ(test::file_bytes(p(std::string("shot/out") + name)),
+                  test::file_bytes(p(std::string("shot/farm") + name)))
+            << name;
+        fs::remove(p(std::string("shot/farm") + name));
+      }
+    }
+  };
+  same_as_run();
+  cut_to_half(p("shot/farm/passes/advection_0001.field"));
+  {
+    std::fstream f(p("shot/farm/passes/advection_0002.field"),
+                   std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(1000);
+    f.put('\x7f');
+  }
+  same_as_run();
 }
 
 // Without --force, a damaged frame is not finished: `run` makes that one again.

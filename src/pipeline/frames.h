@@ -3,20 +3,35 @@
 // Every frame is an interleaved float image in the layout of render/passes.h.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/image.h"
 #include "pipeline/shot_description.h"
 #include "scene/scene.h"
+#include "temporal/advection.h"
 
 namespace emaki::pipeline {
+
+// An advection field made before the synthesis (the farm's passes task keeps each frame's in the
+// pass cache): the field of the layers that advect with `guide`, `patch_size` and `seed`
+// (frame_seed(layer, frame, 1), pipeline/temporal_guide.h) at one frame.
+struct KeptField {
+  AdvectionGuide guide = AdvectionGuide::kRestPosition;
+  int patch_size = 0;
+  uint64_t seed = 0;
+  temporal::AdvectionField field;
+};
 
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
   // The kChannelCount-channel passes of `frame`.
   virtual Image<float> passes(int frame) const = 0;
+  // The advection fields kept for `frame`; any other field is computed where it is needed.
+  virtual std::vector<KeptField> kept_fields(int /*frame*/) const { return {}; }
 };
 
 // Renders the frames of a glTF scene with emaki's renderer.

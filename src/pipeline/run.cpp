@@ -365,7 +365,8 @@ class ShotRun {
   // are read lazily, only if the chain or the composite needs them. True if any was.
   bool synthesize_frame(int f, std::vector<Held>& now) {
     bool changed = false;
-    AdvectionFields fields;
+    // The fields the farm's passes task made ahead are read only when a layer advects.
+    AdvectionFields fields([this, f] { return frames_.kept_fields(f); });
     std::vector<std::optional<LayerFrame>> made = independent_layers(f);
     for (std::size_t i = 0; i < prepared_.size(); ++i) {
       const Layer& l = *prepared_[i].layer;

@@ -59,11 +59,19 @@ void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>&
   params.uniformity_map = synth::Plane(map.cview());
 }
 
+AdvectionFields::AdvectionFields(std::function<std::vector<KeptField>()> kept)
+    : kept_(std::move(kept)) {}
+
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
   if (const temporal::AdvectionField* f = find(l, frame)) return *f;
-  entries_.push_back(std::make_unique<Entry>(
-      Entry{l.temporal.guide, l.synth.patch_size, frame_seed(l, frame, 1), compute()}));
+  if (kept_) {
+    for (KeptField& k : kept_()) entries_.push_back(std::make_unique<KeptField>(std::move(k)));
+    kept_ = nullptr;
+    if (const temporal::AdvectionField* f = find(l, frame)) return *f;
+  }
+  entries_.push_back(std::make_unique<KeptField>(
+      KeptField{l.temporal.guide, l.synth.patch_size, frame_seed(l, frame, 1), compute()}));
   return entries_.back()->field;
 }
 
@@ -73,6 +81,13 @@ const temporal::AdvectionField* AdvectionFields::find(const Layer& l, int frame)
     if (e->guide == l.temporal.guide && e->patch_size == l.synth.patch_size && e->seed == seed)
       return &e->field;
   return nullptr;
+}
+
+std::vector<KeptField> AdvectionFields::release() {
+  std::vector<KeptField> out;
+  for (auto& e : entries_) out.push_back(std::move(*e));
+  entries_.clear();
+  return out;
 }
 
 const Image<float>& AdvectionFields::guide(ImageView<const float> passes, AdvectionGuide guide) {
@@ -145,6 +160,30 @@ Image<float> change_guides(const Layer& l, ImageView<const float> passes) {
   return out;
 }
 
+namespace {
+
+// What the advection of `l` from `previous_passes` to `passes` reads but B'(t-1), its mask and
+// the value flag: the guides and, with a confidence, the surfaces (cut through `cuts`).
+temporal::AdvectionInputs advection_inputs(const Layer& l, ImageView<const float> passes,
+                                           ImageView<const float> previous_passes,
+                                           AdvectionFields& cuts) {
+  temporal::AdvectionInputs a;
+  a.value_channels = l.single_colour ? 1 : 3;
+  a.previous_guide = cuts.guide(previous_passes, l.temporal.guide).cview();
+  a.current_guide = cuts.guide(passes, l.temporal.guide).cview();
+  a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
+  // The confidence's evidence: the surfaces (rest position + object id) whatever the guide.
+  if (l.temporal.confidence) {
+    const AdvectionGuide rest = AdvectionGuide::kRestPosition;
+    a.surfaces = temporal::Surfaces{cuts.guide(previous_passes, rest).cview(),
+                                    cuts.guide(passes, rest).cview(), cuts.motion(passes).cview()};
+    a.confidence = l.temporal.confidence_params;
+  }
+  return a;
+}
+
+}  // namespace
+
 temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
                                  const Image<float>& mask, ImageView<const float> previous,
                                  ImageView<const float> previous_passes, int frame,
@@ -152,35 +191,35 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
   // The frame's cuts, shared through `fields` or made for this call.
   AdvectionFields own;
   AdvectionFields& cuts = fields ? *fields : own;
-  const Image<float>& guide_prev = cuts.guide(previous_passes, l.temporal.guide);
-  const Image<float>& guide_cur = cuts.guide(passes, l.temporal.guide);
-  temporal::AdvectionInputs a;
+  temporal::AdvectionInputs a = advection_inputs(l, passes, previous_passes, cuts);
   a.previous_stylized = previous;
-  a.value_channels = l.single_colour ? 1 : 3;
   a.value = value;
-  a.previous_guide = guide_prev.cview();
-  a.current_guide = guide_cur.cview();
-  a.guide_name = l.temporal.guide == AdvectionGuide::kPosition ? "position_norm" : "rest_position";
   if (!mask.empty()) a.current_mask = mask.cview();
-  // The confidence's evidence: the surfaces (rest position + object id) whatever the guide.
   Image<float> change_prev, change_cur;
-  if (l.temporal.confidence) {
-    const AdvectionGuide rest = AdvectionGuide::kRestPosition;
-    a.surfaces = temporal::Surfaces{cuts.guide(previous_passes, rest).cview(),
-                                    cuts.guide(passes, rest).cview(), cuts.motion(passes).cview()};
-    a.confidence = l.temporal.confidence_params;
-    if (a.confidence.change_none > 0.0f) {
-      change_prev = change_guides(l, previous_passes);
-      change_cur = change_guides(l, passes);
-      if (!change_cur.empty())
-        a.previous_layer_guides = change_prev.cview(), a.current_layer_guides = change_cur.cview();
-    }
+  if (l.temporal.confidence && a.confidence.change_none > 0.0f) {
+    change_prev = change_guides(l, previous_passes);
+    change_cur = change_guides(l, passes);
+    if (!change_cur.empty())
+      a.previous_layer_guides = change_prev.cview(), a.current_layer_guides = change_cur.cview();
   }
   const synth::Params params = synth_params(l.synth, frame_seed(l, frame, 1));
   if (!fields) return temporal::advect(a, params);
   const temporal::AdvectionField& field =
       fields->get(l, frame, [&] { return temporal::advection_field(a, params); });
   return temporal::advect(a, params, &field);
+}
+
+std::vector<KeptField> advection_fields(const Shot& shot, ImageView<const float> previous_passes,
+                                        ImageView<const float> passes, int frame) {
+  AdvectionFields fields;
+  if (frame > shot.source.first_frame)
+    for (const Layer& l : shot.layers) {
+      if (!l.temporal.enabled) continue;
+      const temporal::AdvectionInputs a = advection_inputs(l, passes, previous_passes, fields);
+      const synth::Params params = synth_params(l.synth, frame_seed(l, frame, 1));
+      fields.get(l, frame, [&] { return temporal::advection_field(a, params); });
+    }
+  return fields.release();
 }
 
 }  // namespace emaki::pipeline

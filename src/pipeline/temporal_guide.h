@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "pipeline/frames.h"
 #include "pipeline/shot_description.h"
 #include "synth/synthesizer.h"
 #include "temporal/advection.h"
@@ -49,10 +50,15 @@ void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>&
 // so the layers of a shot, which differ in those, match once per frame instead of once each.
 class AdvectionFields {
  public:
+  // `kept`, when given, is asked once, before the first field is computed, for the fields made
+  // ahead (FrameSource::kept_fields): a field found there is not computed again.
+  explicit AdvectionFields(std::function<std::vector<KeptField>()> kept = {});
   const temporal::AdvectionField& get(const Layer& layer, int frame,
                                       const std::function<temporal::AdvectionField()>& compute);
   // The field get() gave `layer` at `frame`, or null when it has not been computed.
   const temporal::AdvectionField* find(const Layer& layer, int frame) const;
+  // Every field, moved out (the object then holds none).
+  std::vector<KeptField> release();
   // What every layer cuts from a frame's passes (the frame's or the one before), cut once:
   // advection_guide(passes, guide), and the motion (2 channels). `passes` must stay the same
   // image while this object lives.
@@ -67,14 +73,15 @@ class AdvectionFields {
   };
   const Image<float>& cut(ImageView<const float> passes, int what);
   std::vector<std::unique_ptr<Cut>> cuts_;  // stable addresses
-  struct Entry {
-    AdvectionGuide guide;
-    int patch_size;
-    uint64_t seed;
-    temporal::AdvectionField field;
-  };
-  std::vector<std::unique_ptr<Entry>> entries_;  // stable addresses
+  std::function<std::vector<KeptField>()> kept_;
+  std::vector<std::unique_ptr<KeptField>> entries_;  // stable addresses
 };
+
+// The advection fields of `frame` (after the shot's first) for the shot's temporal layers, one
+// per distinct (guide, patch size, seed), from the passes of frame - 1 and of frame: the fields
+// the layers' synthesis computes, made ahead of it (the farm's passes task keeps them).
+std::vector<KeptField> advection_fields(const Shot& shot, ImageView<const float> previous_passes,
+                                        ImageView<const float> passes, int frame);
 
 // B'adv of `layer` at `frame`, from its value at frame - 1 (`previous`: value channels, then
 // the mask coverage when it has a mask) and the passes of both frames. `mask`: the layer's mask

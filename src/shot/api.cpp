@@ -2,11 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
+#include "pipeline/temporal_guide.h"
 #include "shot/input_cache.h"
 #include "shot/inputs.h"
 #include "shot/memory.h"
@@ -147,6 +150,13 @@ void prepare(const pipeline::Shot& shot, const Request& request) {
   keep_references(shot, exemplars, rendered);
 }
 
+namespace {
+
+// The most object ids whose shares a kept advection field carries (store/kept_fields.h).
+constexpr std::size_t kKeptShareIds = 4;
+
+}  // namespace
+
 int render_passes(const pipeline::Shot& shot, const Request& request) {
   pipeline::check_run_options(shot, run_options(request));
   if (shot.source.kind != pipeline::SourceKind::kScene) return 0;
@@ -156,10 +166,31 @@ int render_passes(const pipeline::Shot& shot, const Request& request) {
   io::FileStore store(shot, io::StoreMode::kRun, access(request));
   const int a = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
   const int b = request.last_frame < 0 ? shot.source.last_frame : request.last_frame;
+  // Each frame's advection fields are made here, once, for every temporal layer task to read
+  // (they would otherwise each compute them): from the frame before, read or rendered for the
+  // chunk's first frame.
+  const bool advects = std::any_of(shot.layers.begin(), shot.layers.end(),
+                                   [](const pipeline::Layer& l) { return l.temporal.enabled; });
+  std::optional<Image<float>> previous;
   int rendered = 0;
   for (int f = a; f <= b; ++f) {
-    if (store.has_passes(f)) continue;
-    store.write_passes(f, frames->passes(f).cview());
+    if (store.has_passes(f)) {
+      previous.reset();
+      continue;
+    }
+    Image<float> passes = frames->passes(f);
+    if (advects && f > shot.source.first_frame) {
+      if (!previous) previous = frames->passes(f - 1);
+      std::vector<pipeline::KeptField> fields =
+          pipeline::advection_fields(shot, previous->cview(), passes.cview(), f);
+      // The id shares are a float plane per object id: with many objects they would outweigh the
+      // frame's passes on disk, and the layers make them again in a few ms a frame.
+      for (pipeline::KeptField& k : fields)
+        if (k.field.shares.ids.size() > kKeptShareIds) k.field.shares = {};
+      store.write_kept_fields(f, fields);
+    }
+    store.write_passes(f, passes.cview());
+    previous = std::move(passes);
     ++rendered;
   }
   return rendered;

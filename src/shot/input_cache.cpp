@@ -18,6 +18,10 @@ class KeptFrames : public pipeline::FrameSource {
  public:
   explicit KeptFrames(std::shared_ptr<InputCache::Frames> frames) : m_frames(std::move(frames)) {}
   Image<float> passes(int frame) const override;
+  // Not kept here: the source reads them from the pass cache each time, in about a millisecond.
+  std::vector<pipeline::KeptField> kept_fields(int frame) const override {
+    return m_frames->source->kept_fields(frame);
+  }
 
  private:
   std::shared_ptr<InputCache::Frames> m_frames;

@@ -1,6 +1,10 @@
 #include "store/file_store.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -15,6 +19,7 @@
 #include "io/image_io.h"
 #include "render/passes.h"
 #include "store/field_file.h"
+#include "store/kept_fields.h"
 #include "store/qa_maps.h"
 #include "store/settings_manifests.h"
 
@@ -49,6 +54,9 @@ std::string OutputPaths::contact_sheet() const {
 }
 std::string OutputPaths::passes_exr(int frame) const {
   return fmt::format("{}/passes/frame_{:04d}.exr", folder, frame);
+}
+std::string OutputPaths::passes_fields(int frame) const {
+  return fmt::format("{}/passes/advection_{:04d}.field", folder, frame);
 }
 
 namespace {
@@ -92,6 +100,12 @@ void remove_frames(const fs::path& dir, const std::string& prefix,
 bool is_layer_file(const std::string& name, const std::string& layer) {
   return is_frame_name(name, layer + "_", {".png", ".exr"}) ||
          is_frame_name(name, "." + layer + "_", {".nnf"});
+}
+
+// The pass cache's frames and the advection fields beside them.
+void remove_pass_cache(const std::string& dir) {
+  remove_frames(dir, "frame_", {".exr"});
+  remove_frames(dir, "advection_", {".field"});
 }
 
 void remove_layer_frames(const fs::path& dir, const std::string& layer) {
@@ -178,7 +192,8 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
   std::error_code ec;
   if (fs::is_directory(cache, ec)) {
     clean_up(cache, [](const std::string& t) {
-      return t == kManifest || is_frame_name(t, "frame_", {".exr"});
+      return t == kManifest || is_frame_name(t, "frame_", {".exr"}) ||
+             is_frame_name(t, "advection_", {".field"});
     });
   }
   passes_ = manifested(cache.string(), passes_manifest(shot), "frame_", {".exr"});
@@ -229,8 +244,7 @@ void FileStore::prepare() {
   });
   if (shot_.source.kind == pipeline::SourceKind::kScene) {
     make_folder(root / "passes");
-    make_current(passes_, (root / "passes").string(),
-                 [](const std::string& dir) { remove_frames(dir, "frame_", {".exr"}); });
+    make_current(passes_, (root / "passes").string(), remove_pass_cache);
   }
 }
 
@@ -248,13 +262,25 @@ void FileStore::write_passes(int frame, ImageView<const float> passes) {
   CHECK(access_ != StoreAccess::kInspect);
   const fs::path dir = fs::path(paths_.folder) / "passes";
   make_folder(dir);
-  make_current(passes_, dir.string(),
-               [](const std::string& d) { remove_frames(d, "frame_", {".exr"}); });
+  make_current(passes_, dir.string(), remove_pass_cache);
   WriteOptions exr;
   exr.format = SampleFormat::kFloat;  // bit for bit: every task reads the same floats
   exr.channel_names = render::channel_names();
   exr.compression = kIntermediateCompression;
   write_image(paths_.passes_exr(frame), passes, exr);
+}
+
+void FileStore::write_kept_fields(int frame, const std::vector<pipeline::KeptField>& fields) {
+  CHECK(access_ != StoreAccess::kInspect);
+  const fs::path dir = fs::path(paths_.folder) / "passes";
+  make_folder(dir);
+  make_current(passes_, dir.string(), remove_pass_cache);
+  const std::string path = paths_.passes_fields(frame);
+  const std::string bytes =
+      encode_kept_fields(frame, shot_.source.width, shot_.source.height, fields);
+  TempFile tmp(path, path);
+  tmp.write(bytes.data(), bytes.size());
+  tmp.commit();
 }
 
 FileStore::~FileStore() = default;
@@ -464,6 +490,23 @@ class CachedFrames : public pipeline::FrameSource {
       throw Error(file, fmt::format("is {}x{}, the shot makes {}x{}; {}", img.width(), img.height(),
                                     width_, height_, kRedoHint));
     return img;
+  }
+  // A file that is missing, cut short or damaged gives none: the layers compute theirs. It is
+  // mapped, not read: nothing is allocated for what a file claims before it is checked.
+  std::vector<pipeline::KeptField> kept_fields(int frame) const override {
+    const std::string path = paths_.passes_fields(frame);
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return {};
+    struct stat st {};
+    void* block = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0
+                      ? ::mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0)
+                      : MAP_FAILED;
+    ::close(fd);
+    if (block == MAP_FAILED) return {};
+    std::vector<pipeline::KeptField> fields =
+        decode_kept_fields(block, std::size_t(st.st_size), frame, width_, height_);
+    ::munmap(block, std::size_t(st.st_size));
+    return fields;
   }
 
  private:

@@ -38,6 +38,8 @@ struct OutputPaths {
   std::string mp4() const;
   std::string contact_sheet() const;
   std::string passes_exr(int frame) const;  // the farm's pass cache
+  // Beside a frame's cached passes: its advection fields (store/kept_fields.h).
+  std::string passes_fields(int frame) const;
 };
 
 // Who else may write the folder meanwhile.
@@ -74,6 +76,9 @@ class FileStore : public pipeline::Store {
   // `with_pass_cache`): the prepare task has nothing left to do.
   bool prepared(bool with_pass_cache) const;
   void write_passes(int frame, ImageView<const float> passes);
+  // The frame's advection fields (pipeline::advection_fields) beside its passes; written before
+  // them, so a frame whose passes are there has its fields too.
+  void write_kept_fields(int frame, const std::vector<pipeline::KeptField>& fields);
   bool has_layer(const pipeline::Layer& layer, int frame) const override;
   Image<float> read_layer(const pipeline::Layer& layer, int frame) const override;
   void write_layer(const pipeline::Layer& layer, int frame, ImageView<const float> value) override;
