@@ -76,9 +76,15 @@ class Image {
     const std::size_t row_bytes = std::size_t(width) * channels * sizeof(T);
     const std::size_t padded = (row_bytes + kRowAlign - 1) / kRowAlign * kRowAlign;
     const std::size_t bytes = std::max<std::size_t>(padded * height, kRowAlign);
-    T* mem = static_cast<T*>(std::aligned_alloc(kRowAlign, bytes));
-    if (mem == nullptr) throw std::bad_alloc();
-    mem_ = std::unique_ptr<T, Free>(mem, Free{});
+    // calloc, aligned by hand, rather than aligned_alloc and memset: glibc's calloc does not
+    // write memory fresh from the kernel (zero already), and the memset was a pass over every
+    // new image's pages, faulting them in before their writer did.
+    void* block = std::calloc(bytes + kRowAlign, 1);
+    if (block == nullptr) throw std::bad_alloc();
+    const std::uintptr_t at =
+        (reinterpret_cast<std::uintptr_t>(block) + kRowAlign - 1) & ~std::uintptr_t(kRowAlign - 1);
+    T* mem = reinterpret_cast<T*>(at);
+    mem_ = std::unique_ptr<T, Free>(mem, Free{nullptr, block, 0});
     if (const detail::ImageBlockHook hook =
             detail::image_block_hook.load(std::memory_order_relaxed))
       hook(mem, bytes);
@@ -86,7 +92,6 @@ class Image {
     height_ = height;
     channels_ = channels;
     stride_ = std::ptrdiff_t(padded / sizeof(T));
-    std::memset(mem_.get(), 0, bytes);
   }
 
   // An image over a block the caller made (rows `stride` elements apart, the first at `data`,
@@ -134,16 +139,16 @@ class Image {
   }
 
  private:
-  // std::free, unless the block was adopted.
+  // std::free of the block calloc gave (the data starts inside it), unless it was adopted.
   struct Free {
     void (*release)(void*, std::size_t) = nullptr;
     void* block = nullptr;
     std::size_t bytes = 0;
-    void operator()(T* p) const {
+    void operator()(T*) const {
       if (release)
         release(block, bytes);
       else
-        std::free(p);
+        std::free(block);
     }
   };
   std::unique_ptr<T, Free> mem_;

@@ -1,7 +1,9 @@
 // AVX2 patch distance. Compiled with -mavx2; only called when the CPU has AVX2.
 // Differences of int16 values in [0, 16383] fit int16; madd_epi16 sums two squares into an
-// int32 (<= 2 * 16383^2); three such sums still fit an int32 lane, so lanes are widened to
-// int64 every three chunks and the total is exact.
+// int32 (<= 2 * 16383^2). The plain kernel adds up to eight such sums in a lane taken as
+// unsigned (8 * 2 * 16383^2 < 2^32), so a patch row of up to eight chunks (5x5 patches of 16
+// channels: five) is widened to int64 once; the grouped kernel widens every three chunks. The
+// total is exact either way.
 #include <immintrin.h>
 
 #include "synth/patch_distance.h"
@@ -14,6 +16,12 @@ inline __m256i widen_add(__m256i acc64, __m256i v32) {
   const __m256i hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(v32, 1));
   return _mm256_add_epi64(acc64, _mm256_add_epi64(lo, hi));
 }
+// widen_add for lanes holding unsigned sums (below 2^32).
+inline __m256i widen_add_unsigned(__m256i acc64, __m256i v32) {
+  const __m256i lo = _mm256_cvtepu32_epi64(_mm256_castsi256_si128(v32));
+  const __m256i hi = _mm256_cvtepu32_epi64(_mm256_extracti128_si256(v32, 1));
+  return _mm256_add_epi64(acc64, _mm256_add_epi64(lo, hi));
+}
 inline int64_t hsum64(__m256i v) {
   const __m128i s = _mm_add_epi64(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
   return _mm_cvtsi128_si64(s) + _mm_extract_epi64(s, 1);
@@ -24,7 +32,7 @@ namespace {
 
 // Rows of row_elems elements: 16 per vector, then an 8-element tail. With E > 0 the width is
 // known at compile time (E == row_elems): the row loop unrolls and the widening schedule folds
-// away. Each int32 lane takes at most three squared-pair sums before it is widened to int64.
+// away. Each 32-bit lane takes at most eight squared-pair sums before it is widened to int64.
 template <int E>
 [[gnu::always_inline]] inline int64_t ssd_rows(const int16_t* a, std::ptrdiff_t a_stride,
                                                const int16_t* b, std::ptrdiff_t b_stride,
@@ -43,18 +51,18 @@ template <int E>
       const __m256i vb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(pb + 16 * v));
       const __m256i d = _mm256_sub_epi16(va, vb);
       acc32 = _mm256_add_epi32(acc32, _mm256_madd_epi16(d, d));
-      if (v % 3 == 2) {
-        acc64 = widen_add(acc64, acc32);
+      if (v % 8 == 7) {
+        acc64 = widen_add_unsigned(acc64, acc32);
         acc32 = _mm256_setzero_si256();
       }
     }
-    if (n % 16 != 0) {  // an 8-element tail: the lane then holds at most full % 3 + 1 <= 3 sums
+    if (n % 16 != 0) {  // an 8-element tail: the lane then holds at most full % 8 + 1 <= 8 sums
       const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pa + 16 * full));
       const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + 16 * full));
       const __m128i d = _mm_sub_epi16(va, vb);
       acc32 = _mm256_add_epi32(acc32, _mm256_zextsi128_si256(_mm_madd_epi16(d, d)));
     }
-    acc64 = widen_add(acc64, acc32);
+    acc64 = widen_add_unsigned(acc64, acc32);
     if (j + 1 < rows) {
       const int64_t s = hsum64(acc64);
       if (s > bound) return s;

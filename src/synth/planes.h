@@ -17,9 +17,15 @@ inline bool is_float(const Plane& p) {
   return p.index() == 2;
 }
 
-// Calls fn(y, const float* values) per row of rows [y0, y1), the values normalised.
+// Calls fn(y, const float* values) per row of rows [y0, y1), the values normalised. Float rows
+// are handed over in place (normalised() leaves floats as they are): copying them was a second
+// pass over every guide, once per channel in plane_range.
 template <typename Fn>
 void for_each_row(const Plane& plane, int y0, int y1, Fn&& fn) {
+  if (const auto* f = std::get_if<ImageView<const float>>(&plane)) {
+    for (int y = y0; y < y1; ++y) fn(y, f->row(y));
+    return;
+  }
   std::visit(
       [&](const auto& v) {
         std::vector<float> row(std::size_t(v.width) * v.channels);
