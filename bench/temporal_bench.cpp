@@ -239,14 +239,6 @@ struct Variant {
 // A guide value that moves by no more than this between frames counts as the same light.
 constexpr float kLightTolerance = 0.02f;
 
-double mean_value(const Image<float>& v) {
-  double sum = 0.0;
-  for (int y = 0; y < v.height(); ++y)
-    for (int x = 0; x < v.width(); ++x)
-      for (int c = 0; c < v.channels(); ++c) sum += v(x, y, c);
-  return sum / (double(v.width()) * v.height() * v.channels());
-}
-
 std::string object_name(const pipeline::Shot& shot, int id) {
   std::string name = id == 1 ? "ground" : "object";
   for (std::size_t i = 0; i < shot.source.objects.size(); ++i)
@@ -303,7 +295,9 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // size against the painting's), x=X (the warm start's sharp estimate; unset: 0, -1: from that
 // size as the sigma), u=U (temporal
 // uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed),
-// im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match), fu=U,
+// im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match), ir=SHARE,
+// ig=PASS, ib=BINS, ic=0|1 (the ink per guide, TemporalSpec::ink_ratio, ink_guide, ink_bins,
+// ink_confident), fu=U,
 // fr=RADIUS, ft=TOLERANCE (the uniformity of flat areas, TemporalSpec::flat_uniformity, flat).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
@@ -341,6 +335,14 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.flat.tolerance = x;
     } else if (key == "im") {
       l.temporal.ink_match = x;
+    } else if (key == "ir") {
+      l.temporal.ink_ratio = x;
+    } else if (key == "ig") {
+      l.temporal.ink_guide = value;
+    } else if (key == "ib") {
+      l.temporal.ink_bins = int(x);
+    } else if (key == "ic") {
+      l.temporal.ink_confident = x != 0.0f;
     } else if (key == "is") {
       l.temporal.ink_sigma = x;
     } else if (key == "ar") {
@@ -478,7 +480,7 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
     const Image<float> cur_white = on_white(cur, n), ref_white = on_white(ref, n);
     bench::add_tone_texture(v.wash, cur_white, ref_white, cur, mask_channel, disoccluded);
     if (drift_frame) {
-      v.drift_sum += mean_value(cur_white) - mean_value(ref_white);
+      v.drift_sum += bench::mean_value(cur_white) - bench::mean_value(ref_white);
       ++v.drift_frames;
       bench::add_tone_texture(v.tone, cur_white, ref_white, cur, mask_channel, {});
       bench::add_tone_texture_by_object(v.tone_by_id, cur_white, ref_white, cur, mask_channel,
@@ -557,6 +559,10 @@ int main(int argc, char** argv) {
       variants[i].name = opt.variants[i],
       variants[i].layer = variant_layer(*layer, opt.variants[i], opt);
     run_variants(shot, *layer, *source, variants, opt);
+    if (std::getenv("EMAKI_INK_DUMP"))  // each frame's ink and guides (bench::print_inks)
+      bench::print_inks(*source, *layer, first, last, opt.variants, [&](std::size_t i, int f) {
+        return variants[i].store.read_layer(*layer, f);
+      });
     const bool judging = !opt.judge.empty();
     const std::string judge_fixed = judging ? judge_setup(shot, *layer, opt) : std::string();
     if (!opt.save.empty()) std::filesystem::create_directories(opt.save);

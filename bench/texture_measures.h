@@ -13,7 +13,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <map>
+#include <string>
+#include <vector>
 
 #include "core/image.h"
 #include "pipeline/frames.h"
@@ -147,6 +150,58 @@ inline Image<uint8_t> recently_disoccluded(const Image<uint8_t>& age,
       out(x, y) = age(x, y) < kWashFrames && passes.at(x, y)[render::kAlpha] >= 1.0f &&
                   passes.at(x, y)[render::kOutline] <= 0.0f;
   return out;
+}
+
+// The mean of every channel of every pixel.
+inline double mean_value(const Image<float>& v) {
+  double sum = 0.0;
+  for (int y = 0; y < v.height(); ++y)
+    for (int x = 0; x < v.width(); ++x)
+      for (int c = 0; c < v.channels(); ++c) sum += v(x, y, c);
+  return sum / (double(v.width()) * v.height() * v.channels());
+}
+
+// Frame f's ink: one line of "ink F VARIANT PIXELS INK FRAME_INK G1 ... FRAME_G1 ...": the mean of
+// one minus the layer's value over its mask (INK) and over the whole frame, white outside the mask
+// (FRAME_INK), then the mean of each guide's first channel over the mask, then over the frame.
+inline void print_ink(std::FILE* out, int f, const char* variant, const Image<float>& raw,
+                      int mask_channel, const std::vector<Image<float>>& guides) {
+  double ink = 0.0, frame_ink = 0.0;
+  std::vector<double> g(guides.size()), fg(guides.size());
+  long pixels = 0;
+  for (int y = 0; y < raw.height(); ++y)
+    for (int x = 0; x < raw.width(); ++x) {
+      const bool in = mask_channel < 0 || raw(x, y, mask_channel) >= 0.5f;
+      const float a = mask_channel < 0 ? 1.0f : raw(x, y, mask_channel);
+      frame_ink += a * (1.0 - raw(x, y, 0));
+      for (std::size_t i = 0; i < guides.size(); ++i) fg[i] += guides[i](x, y, 0);
+      if (!in) continue;
+      ++pixels;
+      ink += 1.0 - raw(x, y, 0);
+      for (std::size_t i = 0; i < guides.size(); ++i) g[i] += guides[i](x, y, 0);
+    }
+  const double n = double(raw.width()) * raw.height(), m = std::max(1L, pixels);
+  std::fprintf(out, "ink %d %s %ld %.6f %.6f", f, variant, pixels, ink / m, frame_ink / n);
+  for (double v : g) std::fprintf(out, " %.6f", v / m);
+  for (double v : fg) std::fprintf(out, " %.6f", v / n);
+  std::fprintf(out, "\n");
+}
+
+// print_ink() of every frame first..last of every variant (`names`; read(i, f): variant i's
+// frame f).
+template <class Read>
+void print_inks(const pipeline::FrameSource& source, const pipeline::Layer& layer, int first,
+                int last, const std::vector<std::string>& names, Read read) {
+  for (int f = first; f <= last; ++f) {
+    const Image<float> passes = source.passes(f);
+    std::vector<Image<float>> guides;
+    for (const pipeline::GuideSpec& g : layer.guides)
+      guides.push_back(pipeline::extract_pass(passes.cview(), g.pass));
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const Image<float> raw = read(i, f);
+      print_ink(stdout, f, names[i].c_str(), raw, raw.channels() > 1 ? 1 : -1, guides);
+    }
+  }
 }
 
 }  // namespace emaki::bench

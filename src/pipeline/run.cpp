@@ -13,6 +13,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/shot_keys.h"
+#include "pipeline/ink_ratio.h"
 #include "pipeline/qa_maps.h"
 #include "pipeline/temporal_guide.h"
 #include "pipeline/tone_anchor.h"
@@ -80,21 +81,9 @@ PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const Weight
 struct LayerFrame {
   Image<float> value;
   Image<int32_t> nnf;
-  Image<float> error;  // when asked: the synthesis error (synth::Result::error)
+  Image<float> error;       // when asked: the synthesis error (synth::Result::error)
+  Image<float> confidence;  // at a temporal frame: the temporal guide's, else empty
 };
-
-// The main transfer's schedule with a warm start, unless the layer sets its own counts (which
-// then hold at that one level as at every other): the finest level alone, one search-vote
-// iteration of two PatchMatch sweeps within 32 pixels — what the whole pyramid's finest level
-// runs at a temporal frame. Measured on the example (docs/design/warm-start.md): a random search
-// over the whole exemplar, or two search-vote iterations, evaluate more candidates and lowered the
-// judge's style energy by 0.7-2.2 % only (frames 4 and 12).
-void warm_schedule(const SynthSpec& s, const TemporalSpec& t, synth::Params& p) {
-  if (s.search_vote_iters >= 0 || s.patch_match_iters >= 0) return;
-  p.search_vote_iters = t.finest_iters;
-  p.patch_match_iters = t.warm_patch_match_iters;
-  p.search_radius = 32;
-}
 
 // The temporal guide pair of a layer at a temporal frame: B'adv and its confidence, both sides
 // low-passed with guide_sigma. `target` holds what the pair's target view points into.
@@ -229,7 +218,8 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
   synth::Result r = synth::synthesize(inputs, params, request);
   match_ink(r.image, n, anchor, mask, advected.confidence, l.temporal.ink_sigma,
             l.temporal.ink_match);
-  return {std::move(r.image), std::move(r.nnf), std::move(r.error)};
+  return {std::move(r.image), std::move(r.nnf), std::move(r.error),
+          std::move(temporal_pair.advected.confidence)};
 }
 
 std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<std::string>& names) {
@@ -297,6 +287,7 @@ class ShotRun {
       for (const Layer* l : selected_) total_ += needs(*l, f) ? 1 : 0;
     t0_ = Clock::now();
     held_.resize(prepared_.size());
+    ink_refs_.assign(prepared_.size(), {});
     for (int f = start; f <= b_; ++f) {
       std::vector<Held> now(prepared_.size());
       const bool changed = synthesize_frame(f, now);
@@ -395,6 +386,9 @@ class ShotRun {
       LayerFrame r = made[i] ? std::move(*made[i])
                              : synthesize_layer(prepared_[i], passes(f).cview(), f, previous,
                                                 previous_passes, previous_nnf, &fields, &o_);
+      if (l.temporal.ink_ratio > 0.0f)
+        pin_ink_ratio(l.temporal, prepared_[i].value_channels, passes(f).cview(),
+                      previous != nullptr, ink_refs_[i], r.value, r.confidence);
       if (!r.error.empty())
         store_.write_qa_map("error", l, f,
                             synthesis_error_map(r.error.cview(), r.value.cview(),
@@ -491,7 +485,8 @@ class ShotRun {
   RunReport report_;
   int total_ = 0;  // layer-frames to synthesize
   Clock::time_point t0_;
-  std::vector<Held> held_;  // parallel to prepared_: each layer's last value
+  std::vector<Held> held_;              // parallel to prepared_: each layer's last value
+  std::vector<InkReference> ink_refs_;  // parallel to prepared_ (TemporalSpec::ink_ratio)
   Held prev_passes_;
   std::optional<Image<float>> passes_;  // the current frame's, once read
 };

@@ -183,6 +183,13 @@ struct TemporalSpec {
   // the main transfer; 0: off.
   float ink_match = 0.0f;
   float ink_sigma = 4.0f;
+  // The ink per guide (pipeline/ink_ratio.h): the share of the way each temporal frame's ink is
+  // scaled to keep its ratio to the ink of the pass `ink_guide` ("1-PASS": one minus it; empty:
+  // the coverage alone) at the chain's first frame's; 0: off.
+  float ink_ratio = 0.0f;
+  std::string ink_guide;
+  int ink_bins = 0;  // 0: the ratio of the means; N: the mean ink per bin of the guide's ink
+  bool ink_confident = false;  // each pixel's ink moved by the temporal guide's confidence
   // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
   // iterations in each.
   int finest_iters = 1;

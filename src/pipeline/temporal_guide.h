@@ -114,4 +114,7 @@ Image<int32_t> warm_field(const Layer& layer, ImageView<const int32_t> previous,
                           const temporal::AdvectionField& field, const Image<float>& confidence,
                           const Image<int32_t>& fresh);
 
+// The main transfer's schedule with a warm start, unless the layer sets its own counts.
+void warm_schedule(const SynthSpec& s, const TemporalSpec& t, synth::Params& p);
+
 }  // namespace emaki::pipeline

@@ -1,0 +1,39 @@
+// The ink per guide of a layer along its temporal chain (TemporalSpec::ink_ratio): the mean ink
+// of the result (one minus its value) over its coverage, divided by the mean ink of one of its
+// guide passes over the same pixels (no guide: the mean ink per covered pixel), is measured at
+// the chain's first frame; at every temporal frame after it the result's ink is scaled (one
+// factor over the frame) so the ratio comes back to that first frame's. The `shadow` and
+// `outline` kinds have no temporal guide, so the tone anchor does not reach them and their ink
+// walks with the shot's length; frame by frame keeps the mean ink per covered pixel steadier
+// than the chain does, not its ratio to a guide's. Off by default (docs/design/ink-ratio.md).
+#pragma once
+
+#include <vector>
+
+#include "core/image.h"
+#include "pipeline/shot_description.h"
+
+namespace emaki::pipeline {
+
+// What a temporal frame's ink is pinned to, measured at the chain's first frame: the ratio of the
+// layer's mean ink to its guide's (one entry; TemporalSpec::ink_bins 0), or the layer's mean ink
+// at the pixels whose guide ink falls in each of ink_bins equal bins of [0, 1]. Empty where the
+// layer or its guide has no ink.
+struct InkReference {
+  std::vector<double> per_bin;
+};
+// `value`: value channels, then its coverage (pixels below 0.5 are left out).
+InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, int value_channels,
+                           ImageView<const float> passes);
+
+// At the chain's first frame (`chained` false) or with no reference yet (a run resumed inside the
+// chain), measures `ref` on `value`; at a temporal frame, scales `value`'s ink inside its
+// coverage t.ink_ratio of the way to what `ref` expects from the frame's guide, by one factor
+// within [1/2, 2], each value clamped to [0, 1]. With t.ink_confident and a `confidence` (the
+// temporal guide's), each pixel's ink moves by its confidence, the factor set so the mean still
+// comes to what `ref` expects: pixels the chain did not carry (uncovered ones) keep their ink.
+void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const float> passes,
+                   bool chained, InkReference& ref, Image<float>& value,
+                   const Image<float>& confidence = {});
+
+}  // namespace emaki::pipeline
