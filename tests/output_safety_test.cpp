@@ -4,6 +4,7 @@
 // other settings (a resize, a single_colour toggle) when resuming.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -294,11 +295,15 @@ TEST_F(OutputSafety, SecondRunOnTheSameFolderNamesTheHolder) {
          std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   ASSERT_NE(slurp(lock).find("pid"), std::string::npos);
+  // Held still while the others try, so a fast machine cannot finish it first (8 small frames
+  // took 1.5 s); a stopped child is not reported by waitpid without WUNTRACED.
+  ASSERT_EQ(::kill(first, SIGSTOP), 0);
 
   const test::CliResult second = emaki("run " + p("shot.toml"));
   const test::CliResult composite = emaki("composite " + p("shot.toml"));
   int status = 0;
   const bool first_still_running = ::waitpid(first, &status, WNOHANG) == 0;
+  ::kill(first, SIGCONT);
   if (first_still_running) ::waitpid(first, &status, 0);
   ASSERT_TRUE(first_still_running) << "the first run finished before the second started";
 
