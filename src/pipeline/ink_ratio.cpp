@@ -39,25 +39,34 @@ double ink_at(ImageView<const float> v, int n, int x, int y) {
   return s / n;
 }
 
-// The layer's mean ink over its coverage, and what the reference expects there: `ref`'s ratio
-// times the guide's mean ink, or the mean of its per-bin inks at each pixel's bin.
+// The layer's mean ink over its coverage, what the reference expects there (`ref`'s ratio times
+// the guide's mean ink, or the mean of its per-bin inks at each pixel's bin), and the mean ink
+// weighted by `trust` (clamped to [0, 1]; null: 1), the share a per-pixel scaling moves.
 struct Inks {
-  double layer = 0.0, expected = 0.0;
+  double layer = 0.0, expected = 0.0, trusted = 0.0;
 };
 
-Inks inks(const InkGuide& g, ImageView<const float> v, int n, const InkReference& ref) {
+float trust_at(const Image<float>* trust, int x, int y) {
+  return trust ? std::clamp((*trust)(x, y), 0.0f, 1.0f) : 1.0f;
+}
+
+Inks inks(const InkGuide& g, ImageView<const float> v, int n, const InkReference& ref,
+          const Image<float>* trust) {
   Inks s;
   long pixels = 0;
   for (int y = 0; y < v.height; ++y)
     for (int x = 0; x < v.width; ++x) {
       if (!covered(v, n, x, y)) continue;
       ++pixels;
-      s.layer += ink_at(v, n, x, y);
+      const double ink = ink_at(v, n, x, y);
+      s.layer += ink;
+      s.trusted += trust_at(trust, x, y) * ink;
       const float gi = g.at(x, y);
       s.expected += g.bins > 0 ? ref.per_bin[g.bin(gi)] : ref.per_bin[0] * gi;
     }
   if (pixels == 0) return {};
-  return {s.layer / double(pixels), s.expected / double(pixels)};
+  const double m = double(pixels);
+  return {s.layer / m, s.expected / m, s.trusted / m};
 }
 
 }  // namespace
@@ -101,31 +110,17 @@ void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const fl
     ref = ink_reference(t, value.cview(), value_channels, passes);
     return;
   }
-  const Inks s = inks(InkGuide(t, passes), value.cview(), value_channels, ref);
-  if (s.layer <= kFloor || s.expected <= kFloor) return;
+  const Image<float>* trust = t.ink_confident && !confidence.empty() ? &confidence : nullptr;
+  const Inks s = inks(InkGuide(t, passes), value.cview(), value_channels, ref, trust);
+  // s.trusted, the ink the factor moves, is its lever.
+  if (s.layer <= kFloor || s.expected <= kFloor || s.trusted <= kFloor) return;
   const int n = value_channels;
-  const bool weighted = t.ink_confident && !confidence.empty();
-  const auto trust = [&](int x, int y) {
-    return weighted ? std::clamp(confidence(x, y), 0.0f, 1.0f) : 1.0f;
-  };
-  // The mean ink of the pixels the factor moves, each by its trust: the factor's lever.
-  double lever = s.layer;
-  if (weighted) {
-    double sum = 0.0;
-    long pixels = 0;
-    for (int y = 0; y < value.height(); ++y)
-      for (int x = 0; x < value.width(); ++x)
-        if (covered(value.cview(), n, x, y))
-          sum += trust(x, y) * ink_at(value.cview(), n, x, y), ++pixels;
-    lever = pixels ? sum / double(pixels) : 0.0;
-  }
-  if (lever <= kFloor) return;
-  const double k = std::clamp(1.0 + (s.expected - s.layer) / lever, 0.5, 2.0);
+  const double k = std::clamp(1.0 + (s.expected - s.layer) / s.trusted, 0.5, 2.0);
   const float share = float(t.ink_ratio * (k - 1.0));
   for (int y = 0; y < value.height(); ++y)
     for (int x = 0; x < value.width(); ++x) {
       if (!covered(value.cview(), n, x, y)) continue;
-      const float scale = 1.0f + trust(x, y) * share;
+      const float scale = 1.0f + trust_at(trust, x, y) * share;
       for (int c = 0; c < n; ++c)
         value(x, y, c) = std::clamp(1.0f - scale * (1.0f - value(x, y, c)), 0.0f, 1.0f);
     }
