@@ -208,7 +208,9 @@ def section_render(a, build):
 
 
 def section_shot(a, build):
-    sizes = [("960x540", 6)] + ([("1920x1080", 4)] if a.full else [])
+    # 17 frames: two of the temporal frames re-measure the ink layers' reference (every 8 frames,
+    # docs/design/ink-ratio.md), as often as along a whole shot.
+    sizes = [("960x540", 17)] + ([("1920x1080", 9)] if a.full else [])
     lines = ["## A shot in memory", "",
              "The bundled shot (three layers, temporal on) without files: rendering, synthesis, "
              f"advection and compositing; {runs_text(a.runs)}:", "", "```sh"]

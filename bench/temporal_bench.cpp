@@ -2,13 +2,11 @@
 // run frame by frame and with advection by `position` (the paper's) or `rest_position`, each with
 // or without the advection's confidence as the temporal guide's weight map, compared on flicker
 // (`emaki qa flicker`'s measure, split into the scene's objects and the static ground, then per
-// object id), on ghosts
-// (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with --judge, on the
-// independent judge's `style` energy of sampled frames (is the output still made of exemplar
-// texture?) and coverage, and on drift (the mean value of the layer, white outside its mask, 0-255,
-// against frame by frame over the last quarter of the frames: a chain that darkens or fades).
-// Frames stay in memory; nothing is written except the judge's inputs and, with
-// --save, the variants' layer frames as PNGs.
+// object id), on ghosts (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with
+// --judge, on the independent judge's `style` energy of sampled frames (is the output still made of
+// exemplar texture?) and coverage, and on drift (the mean value of the layer, white outside its
+// mask, 0-255, against frame by frame over the last quarter of the frames: a chain that darkens or
+// fades). Frames stay in memory; only the judge's inputs and --save's PNGs are written.
 //
 //   temporal_bench [--shot SHOT.toml] [--size WxH (the shot's)] [--frames 48] [--layer base]
 //                  [--variants frame,rest_position_noconf_uniform@1,rest_position,...]
@@ -22,8 +20,8 @@
 // `rest_position_noconf` (temporal_confidence = false); a `_cold` suffix runs the whole pyramid at
 // every frame (temporal_warm_start = false); a `_uniform` suffix keeps the layer's
 // uniformity at temporal frames (temporal_uniformity = uniformity, or --temporal-uniformity U),
-// @W gives the variant the
-// temporal weight W (`rest_position_noconf_uniform@1`: the example before the confidence).
+// @W gives the variant the temporal weight W (`rest_position_noconf_uniform@1`: the example
+// before the confidence).
 // --error-*, --foreign-none and --erode set the confidence's parameters
 // (temporal::ConfidenceParams), --temporal-weight the temporal weight of every temporal variant
 // without @W. The judge is ../shared/tools/judge (build it with its build.sh). Its guides are
@@ -296,9 +294,9 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // size as the sigma), u=U (temporal
 // uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed),
 // im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match), ir=SHARE,
-// ig=PASS, ib=BINS, ic=0|1 (the ink per guide, TemporalSpec::ink_ratio, ink_guide, ink_bins,
-// ink_confident), fu=U,
-// fr=RADIUS, ft=TOLERANCE (the uniformity of flat areas, TemporalSpec::flat_uniformity, flat).
+// ig=PASS, ib=BINS, ic=0|1, ik=FRAMES (the ink per guide, TemporalSpec::ink_ratio, ink_guide,
+// ink_bins, ink_confident, ink_refresh), fu=U, fr=RADIUS, ft=TOLERANCE (the uniformity of flat
+// areas, TemporalSpec::flat_uniformity, flat).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
   for (std::string m; std::getline(ss, m, ':');) {
@@ -341,6 +339,8 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.ink_guide = value;
     } else if (key == "ib") {
       l.temporal.ink_bins = int(x);
+    } else if (key == "ik") {
+      l.temporal.ink_refresh = int(x);
     } else if (key == "ic") {
       l.temporal.ink_confident = x != 0.0f;
     } else if (key == "is") {

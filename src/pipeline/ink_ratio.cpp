@@ -103,6 +103,11 @@ InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, 
   return ref;
 }
 
+int ink_reference_frame(const TemporalSpec& t, int first, int f) {
+  if (t.ink_refresh <= 0 || f <= first) return first;
+  return first + (f - first) / t.ink_refresh * t.ink_refresh;
+}
+
 void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const float> passes,
                    bool chained, InkReference& ref, Image<float>& value,
                    const Image<float>& confidence) {

@@ -21,7 +21,13 @@ namespace emaki::pipeline {
 // layer or its guide has no ink.
 struct InkReference {
   std::vector<double> per_bin;
+  int frame = -1;  // the frame it was measured at, if known
 };
+
+// With t.ink_refresh > 0, the frame whose fresh transfer sets frame f's reference: the last one
+// ink_refresh frames apart from the chain's first frame `first`. Frames are numbered from the
+// shot's chain start, not the run's, so a resumed run or a farm chunk measures the same frame.
+int ink_reference_frame(const TemporalSpec& t, int first, int f);
 // `value`: value channels, then its coverage (pixels below 0.5 are left out).
 InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, int value_channels,
                            ImageView<const float> passes);

@@ -50,5 +50,15 @@ TEST(InkRatio, LeavesThePixelsTheChainDidNotCarryWithTheConfidence) {
   EXPECT_NEAR(later(5, 3, 0), 0.5f, 1e-6);
 }
 
+TEST(InkRatio, RefreshFramesCountFromTheChainsFirstFrame) {
+  TemporalSpec t;
+  EXPECT_EQ(ink_reference_frame(t, 10, 25), 10);  // no refresh: the first frame's alone
+  t.ink_refresh = 8;
+  EXPECT_EQ(ink_reference_frame(t, 10, 10), 10);
+  EXPECT_EQ(ink_reference_frame(t, 10, 17), 10);
+  EXPECT_EQ(ink_reference_frame(t, 10, 18), 18);
+  EXPECT_EQ(ink_reference_frame(t, 10, 33), 26);
+}
+
 }  // namespace
 }  // namespace emaki::pipeline

@@ -246,6 +246,35 @@ TEST(Pipeline, RunsResumesAndContinuesTheChain) {
   EXPECT_EQ(r.composited, 1);
 }
 
+// TemporalSpec::ink_refresh: the reference is re-measured on fresh transfers of frames counted
+// from the chain's first, so a run resumed anywhere in the chain makes the same frames.
+TEST(Pipeline, InkRefreshResumesAnywhereWithTheSameFrames) {
+  Shot shot = tiny_shot();
+  shot.source.last_frame = 5;
+  const SlidingFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  RunOptions o;
+  MemoryStore plain;
+  run_shot(shot, frames, ex, CompositeInputs{}, plain, o);
+  TemporalSpec& t = shot.layers[0].temporal;
+  t.ink_ratio = 1.0f;
+  t.ink_confident = true;
+  t.ink_refresh = 2;
+  MemoryStore full;
+  run_shot(shot, frames, ex, CompositeInputs{}, full, o);
+  bool pinned = false;
+  for (int f = 1; f <= 5; ++f) pinned = pinned || !same_layer(plain, full, f);
+  EXPECT_TRUE(pinned);
+  for (int stop : {2, 3}) {  // resumed at a refresh frame's successor (3) and at one (4)
+    MemoryStore part;
+    o.last_frame = stop;
+    run_shot(shot, frames, ex, CompositeInputs{}, part, o);
+    o.last_frame = -1;
+    EXPECT_EQ(run_shot(shot, frames, ex, CompositeInputs{}, part, o).synthesized, 5 - stop);
+    for (int f = 0; f <= 5; ++f) EXPECT_TRUE(same_layer(full, part, f)) << stop << " " << f;
+  }
+}
+
 TEST(Pipeline, WarmStartResumesFromTheStoredFieldOnly) {
   const Shot shot = tiny_shot();
   const SlidingFrames frames(40, 30);

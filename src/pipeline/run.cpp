@@ -386,9 +386,12 @@ class ShotRun {
       LayerFrame r = made[i] ? std::move(*made[i])
                              : synthesize_layer(prepared_[i], passes(f).cview(), f, previous,
                                                 previous_passes, previous_nnf, &fields, &o_);
-      if (l.temporal.ink_ratio > 0.0f)
+      if (l.temporal.ink_ratio > 0.0f) {
+        if (previous) refresh_ink_reference(i, f);
         pin_ink_ratio(l.temporal, prepared_[i].value_channels, passes(f).cview(),
                       previous != nullptr, ink_refs_[i], r.value, r.confidence);
+        if (!previous) ink_refs_[i].frame = f;
+      }
       if (!r.error.empty())
         store_.write_qa_map("error", l, f,
                             synthesis_error_map(r.error.cview(), r.value.cview(),
@@ -408,6 +411,20 @@ class ShotRun {
       changed = true;
     }
     return changed;
+  }
+
+  // TemporalSpec::ink_refresh: the reference of layer i's frame f, measured on a fresh transfer
+  // of the frame ink_reference_frame() names (the same in a resumed run or a farm chunk).
+  void refresh_ink_reference(std::size_t i, int f) {
+    const TemporalSpec& t = prepared_[i].layer->temporal;
+    const int r = ink_reference_frame(t, first_, f);
+    if (t.ink_refresh <= 0 || ink_refs_[i].frame == r) return;
+    const Image<float> other = r == f ? Image<float>() : frames_.passes(r);
+    const ImageView<const float> p = r == f ? passes(f).cview() : other.cview();
+    AdvectionFields none;
+    const LayerFrame fresh = synthesize_layer(prepared_[i], p, r, nullptr, nullptr, {}, &none, &o_);
+    ink_refs_[i] = ink_reference(t, fresh.value.cview(), prepared_[i].value_channels, p);
+    ink_refs_[i].frame = r;
   }
 
   // With RunOptions::concurrent_layers, the layers frame f needs that do not continue a chain
@@ -548,42 +565,6 @@ int recomposite(const Shot& shot, const FrameSource& frames, const CompositeInpu
     ++written;
   }
   return written;
-}
-
-Image<float> contact_sheet(const std::vector<Image<float>>& frames, int columns, int thumb_width) {
-  CHECK(!frames.empty());
-  CHECK_GT(columns, 0);
-  const int fw = frames[0].width(), fh = frames[0].height();
-  const int tw = std::min(thumb_width, fw);
-  const int th = std::max(1, int(std::lround(double(fh) * tw / fw)));
-  const int gap = 4;
-  const int rows = (int(frames.size()) + columns - 1) / columns;
-  const int cols = std::min<int>(columns, int(frames.size()));
-  Image<float> sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3);
-  sheet.fill(1.0f);
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    // Each thumbnail samples its own frame's size and channels: frames read back from disk need
-    // not all match the first one, and a mismatch must never index past a frame.
-    const Image<float>& f = frames[i];
-    if (f.empty()) continue;
-    const int sw = f.width(), sh = f.height(), last_channel = f.channels() - 1;
-    const int ox = gap + int(i % columns) * (tw + gap), oy = gap + int(i / columns) * (th + gap);
-    // Box filter over the source pixels each thumbnail pixel covers.
-    for (int y = 0; y < th; ++y)
-      for (int x = 0; x < tw; ++x) {
-        const int x0 = int(int64_t(x) * sw / tw),
-                  x1 = std::max(x0 + 1, int(int64_t(x + 1) * sw / tw));
-        const int y0 = int(int64_t(y) * sh / th),
-                  y1 = std::max(y0 + 1, int(int64_t(y + 1) * sh / th));
-        for (int c = 0; c < 3; ++c) {
-          double s = 0;
-          for (int yy = y0; yy < y1; ++yy)
-            for (int xx = x0; xx < x1; ++xx) s += f(xx, yy, std::min(c, last_channel));
-          sheet(ox + x, oy + y, c) = float(s / ((x1 - x0) * (y1 - y0)));
-        }
-      }
-  }
-  return sheet;
 }
 
 void check_run_options(const Shot& shot, const RunOptions& options) {

@@ -190,6 +190,10 @@ struct TemporalSpec {
   std::string ink_guide;
   int ink_bins = 0;  // 0: the ratio of the means; N: the mean ink per bin of the guide's ink
   bool ink_confident = false;  // each pixel's ink moved by the temporal guide's confidence
+  // Every ink_refresh frames from the chain's first, the reference is measured again on a fresh
+  // transfer of that frame (frame by frame's result), so it follows the shot's own trend; 0: the
+  // chain's first frame's alone.
+  int ink_refresh = 0;
   // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
   // iterations in each.
   int finest_iters = 1;

@@ -28,6 +28,12 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // their texture and tone back and leaves smaller shadows, which flickered with it, as they
       // were (docs/design/long-shots.md).
       d.temporal_flat_uniformity = true;
+      // Without a temporal guide the anchor's tone does not reach the layer and its ink walks
+      // with the shot's length; pinned to a fresh transfer's every 8 frames it stays within a
+      // level of frame by frame's. Only the pixels the chain carried move: moved all alike, the
+      // pixels a moving light uncovers came out lighter (docs/design/ink-ratio.md).
+      d.temporal_ink_refresh = 8;
+      d.temporal_ink_confident = true;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};
@@ -37,6 +43,8 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // As the shadow: the temporal guide faded the ink (docs/design/temporal-default.md).
       d.temporal_weight = 0.0f;
       d.temporal_uniformity = 0.0f;
+      // As the shadow, every pixel alike: moved by the confidence the line flickered more.
+      d.temporal_ink_refresh = 8;
       break;
     case pipeline::LayerKind::kCustom:
       break;

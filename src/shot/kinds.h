@@ -109,6 +109,12 @@ struct KindDefaults {
   // Whether temporal frames add the layer's own `uniformity` (the first frame's) inside large
   // flat areas of its guides (TemporalSpec::flat_uniformity; not a shot-file key).
   bool temporal_flat_uniformity = false;
+  // Every how many frames temporal frames re-measure the mean ink per covered pixel they are
+  // pinned to on a fresh transfer (TemporalSpec::ink_refresh, with ink_ratio 1; 0: no pin), and
+  // whether each pixel moves by the temporal guide's confidence (ink_confident). Not shot-file
+  // keys.
+  int temporal_ink_refresh = 0;
+  bool temporal_ink_confident = false;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

@@ -77,6 +77,14 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_FLOAT_EQ(s.layers[2].temporal.flat_uniformity, 3500.0f);
   EXPECT_FLOAT_EQ(s.layers[1].temporal.flat_uniformity, 0.0f);
   EXPECT_FLOAT_EQ(s.layers[0].temporal.flat_uniformity, 0.0f);
+  // Shadow and outline pin their ink per covered pixel to a fresh transfer's every 8 frames.
+  for (int i : {1, 2}) {
+    EXPECT_FLOAT_EQ(s.layers[i].temporal.ink_ratio, 1.0f);
+    EXPECT_EQ(s.layers[i].temporal.ink_refresh, 8);
+  }
+  EXPECT_TRUE(s.layers[2].temporal.ink_confident);  // the shadow's uncovered pixels keep theirs
+  EXPECT_FALSE(s.layers[1].temporal.ink_confident);
+  EXPECT_FLOAT_EQ(s.layers[0].temporal.ink_ratio, 0.0f);
   EXPECT_FLOAT_EQ(parse_shot(minimal("[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"
                                      "uniformity = 2000\n"),
                              "/tmp/shot.toml")
