@@ -294,7 +294,7 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // size as the sigma), u=U (temporal
 // uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed),
 // im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match), ir=SHARE,
-// ig=PASS, ib=BINS, ic=0|1, ik=FRAMES (the ink per guide, TemporalSpec::ink_ratio, ink_guide,
+// ig=PASS, ib=BINS, ic=W, ik=FRAMES (the ink per guide, TemporalSpec::ink_ratio, ink_guide,
 // ink_bins, ink_confident, ink_refresh), fu=U, fr=RADIUS, ft=TOLERANCE (the uniformity of flat
 // areas, TemporalSpec::flat_uniformity, flat).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
@@ -342,7 +342,7 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
     } else if (key == "ik") {
       l.temporal.ink_refresh = int(x);
     } else if (key == "ic") {
-      l.temporal.ink_confident = x != 0.0f;
+      l.temporal.ink_confident = x;
     } else if (key == "is") {
       l.temporal.ink_sigma = x;
     } else if (key == "ar") {

@@ -41,17 +41,24 @@ double ink_at(ImageView<const float> v, int n, int x, int y) {
 
 // The layer's mean ink over its coverage, what the reference expects there (`ref`'s ratio times
 // the guide's mean ink, or the mean of its per-bin inks at each pixel's bin), and the mean ink
-// weighted by `trust` (clamped to [0, 1]; null: 1), the share a per-pixel scaling moves.
+// weighted by Trust, the share a per-pixel scaling moves.
 struct Inks {
   double layer = 0.0, expected = 0.0, trusted = 0.0;
 };
 
-float trust_at(const Image<float>* trust, int x, int y) {
-  return trust ? std::clamp((*trust)(x, y), 0.0f, 1.0f) : 1.0f;
-}
+// How much of the frame's factor a pixel takes: 1 - w + w x its confidence (TemporalSpec::
+// ink_confident w; no confidence: 1).
+struct Trust {
+  const Image<float>* confidence = nullptr;
+  float weight = 0.0f;
+  float at(int x, int y) const {
+    if (!confidence) return 1.0f;
+    return 1.0f - weight + weight * std::clamp((*confidence)(x, y), 0.0f, 1.0f);
+  }
+};
 
 Inks inks(const InkGuide& g, ImageView<const float> v, int n, const InkReference& ref,
-          const Image<float>* trust) {
+          const Trust& trust) {
   Inks s;
   long pixels = 0;
   for (int y = 0; y < v.height; ++y)
@@ -60,7 +67,7 @@ Inks inks(const InkGuide& g, ImageView<const float> v, int n, const InkReference
       ++pixels;
       const double ink = ink_at(v, n, x, y);
       s.layer += ink;
-      s.trusted += trust_at(trust, x, y) * ink;
+      s.trusted += trust.at(x, y) * ink;
       const float gi = g.at(x, y);
       s.expected += g.bins > 0 ? ref.per_bin[g.bin(gi)] : ref.per_bin[0] * gi;
     }
@@ -115,7 +122,8 @@ void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const fl
     ref = ink_reference(t, value.cview(), value_channels, passes);
     return;
   }
-  const Image<float>* trust = t.ink_confident && !confidence.empty() ? &confidence : nullptr;
+  const Trust trust{t.ink_confident > 0.0f && !confidence.empty() ? &confidence : nullptr,
+                    std::clamp(t.ink_confident, 0.0f, 1.0f)};
   const Inks s = inks(InkGuide(t, passes), value.cview(), value_channels, ref, trust);
   // s.trusted, the ink the factor moves, is its lever.
   if (s.layer <= kFloor || s.expected <= kFloor || s.trusted <= kFloor) return;
@@ -125,7 +133,7 @@ void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const fl
   for (int y = 0; y < value.height(); ++y)
     for (int x = 0; x < value.width(); ++x) {
       if (!covered(value.cview(), n, x, y)) continue;
-      const float scale = 1.0f + trust_at(trust, x, y) * share;
+      const float scale = 1.0f + trust.at(x, y) * share;
       for (int c = 0; c < n; ++c)
         value(x, y, c) = std::clamp(1.0f - scale * (1.0f - value(x, y, c)), 0.0f, 1.0f);
     }

@@ -35,9 +35,10 @@ InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, 
 // At the chain's first frame (`chained` false) or with no reference yet (a run resumed inside the
 // chain), measures `ref` on `value`; at a temporal frame, scales `value`'s ink inside its
 // coverage t.ink_ratio of the way to what `ref` expects from the frame's guide, by one factor
-// within [1/2, 2], each value clamped to [0, 1]. With t.ink_confident and a `confidence` (the
-// temporal guide's), each pixel's ink moves by its confidence, the factor set so the mean still
-// comes to what `ref` expects: pixels the chain did not carry (uncovered ones) keep their ink.
+// within [1/2, 2], each value clamped to [0, 1]. With t.ink_confident w > 0 and a `confidence`
+// (the temporal guide's), each pixel's ink moves by 1 - w + w x its confidence, the factor set so
+// the mean still comes to what `ref` expects: at w = 1 the pixels the chain did not carry
+// (uncovered ones) keep their ink.
 void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const float> passes,
                    bool chained, InkReference& ref, Image<float>& value,
                    const Image<float>& confidence = {});

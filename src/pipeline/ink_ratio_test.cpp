@@ -36,7 +36,7 @@ TEST(InkRatio, PinsTheFirstFramesInkInsideTheCoverage) {
 TEST(InkRatio, LeavesThePixelsTheChainDidNotCarryWithTheConfidence) {
   TemporalSpec t;
   t.ink_ratio = 1.0f;
-  t.ink_confident = true;
+  t.ink_confident = 1.0f;
   InkReference ref;
   Image<float> first = half_covered(0.6f);
   pin_ink_ratio(t, 1, {}, false, ref, first);
@@ -48,6 +48,13 @@ TEST(InkRatio, LeavesThePixelsTheChainDidNotCarryWithTheConfidence) {
   EXPECT_FLOAT_EQ(later(1, 3, 0), 0.7f);  // uncovered: its ink stays
   // The carried pixels take the whole difference: the mean ink comes back to 0.4.
   EXPECT_NEAR(later(5, 3, 0), 0.5f, 1e-6);
+  // Half weighted: the uncovered pixels take half the factor's move, the carried ones all of it,
+  // and the mean still comes back (inks 0.3 -> 0.3667 and 0.4333).
+  t.ink_confident = 0.5f;
+  Image<float> half = half_covered(0.7f);
+  pin_ink_ratio(t, 1, {}, true, ref, half, confidence);
+  EXPECT_NEAR(half(1, 3, 0), 1.0f - 0.3f * (1.0f + 0.5f * 4.0f / 9.0f), 1e-5);
+  EXPECT_NEAR(half(5, 3, 0), 1.0f - 0.3f * (1.0f + 4.0f / 9.0f), 1e-5);
 }
 
 TEST(InkRatio, RefreshFramesCountFromTheChainsFirstFrame) {

@@ -258,7 +258,7 @@ TEST(Pipeline, InkRefreshResumesAnywhereWithTheSameFrames) {
   run_shot(shot, frames, ex, CompositeInputs{}, plain, o);
   TemporalSpec& t = shot.layers[0].temporal;
   t.ink_ratio = 1.0f;
-  t.ink_confident = true;
+  t.ink_confident = 1.0f;
   t.ink_refresh = 2;
   MemoryStore full;
   run_shot(shot, frames, ex, CompositeInputs{}, full, o);

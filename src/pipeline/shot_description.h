@@ -189,7 +189,10 @@ struct TemporalSpec {
   float ink_ratio = 0.0f;
   std::string ink_guide;
   int ink_bins = 0;  // 0: the ratio of the means; N: the mean ink per bin of the guide's ink
-  bool ink_confident = false;  // each pixel's ink moved by the temporal guide's confidence
+  // The share of each pixel's move set by the temporal guide's confidence: it takes
+  // 1 - w + w x confidence of the frame's factor (0: every pixel alike; 1: uncovered pixels keep
+  // their ink).
+  float ink_confident = 0.0f;
   // Every ink_refresh frames from the chain's first, the reference is measured again on a fresh
   // transfer of that frame (frame by frame's result), so it follows the shot's own trend; 0: the
   // chain's first frame's alone.
@@ -210,7 +213,7 @@ struct SynthSpec {
 };
 
 // What a layer is for: sets its defaults (shot/kinds.h).
-enum class LayerKind { kBase, kOutline, kShadow, kCustom };
+enum class LayerKind { kBase, kOutline, kShadow, kHatching, kCustom };
 
 struct Layer {
   std::string name;

@@ -33,7 +33,7 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // level of frame by frame's. Only the pixels the chain carried move: moved all alike, the
       // pixels a moving light uncovers came out lighter (docs/design/ink-ratio.md).
       d.temporal_ink_refresh = 8;
-      d.temporal_ink_confident = true;
+      d.temporal_ink_confident = 1.0f;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};
@@ -43,8 +43,23 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // As the shadow: the temporal guide faded the ink (docs/design/temporal-default.md).
       d.temporal_weight = 0.0f;
       d.temporal_uniformity = 0.0f;
-      // As the shadow, every pixel alike: moved by the confidence the line flickered more.
+      // As the shadow, each pixel moved half by its confidence: moved by it alone the line
+      // flickered more, moved all alike the lines that appear came out lighter.
       d.temporal_ink_refresh = 8;
+      d.temporal_ink_confident = 0.5f;
+      break;
+    case pipeline::LayerKind::kHatching:
+      // Dark strokes of a second style over the base: the strokes cover, the paper does not.
+      d.guides = {{"normal", 1.0f}, {"diffuse", 1.5f}, {"shadow", 1.0f}};
+      d.mask = {pipeline::MaskKind::kCovered, 0.0f, 0.5f};
+      d.look.flat = {0.2f, 0.15f, 0.3f};
+      d.look.alpha_from = composite::AlphaFrom::kInverseValue;
+      d.look.blend = composite::BlendMode::kMultiply;
+      // A sparse painting thins out along the chain as the camera closes in, and the quarter-size
+      // anchor cannot hold strokes a few pixels wide: pinned as the shadow, the strokes keep
+      // more of frame by frame's texture and its tone (docs/design/ink-ratio.md).
+      d.temporal_ink_refresh = 8;
+      d.temporal_ink_confident = 1.0f;
       break;
     case pipeline::LayerKind::kCustom:
       break;

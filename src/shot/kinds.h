@@ -20,9 +20,8 @@ struct Named {
 };
 
 inline constexpr Named<pipeline::LayerKind> kLayerKinds[] = {
-    {"base", pipeline::LayerKind::kBase},
-    {"outline", pipeline::LayerKind::kOutline},
-    {"shadow", pipeline::LayerKind::kShadow},
+    {"base", pipeline::LayerKind::kBase},     {"outline", pipeline::LayerKind::kOutline},
+    {"shadow", pipeline::LayerKind::kShadow}, {"hatching", pipeline::LayerKind::kHatching},
     {"custom", pipeline::LayerKind::kCustom},
 };
 inline constexpr Named<pipeline::SourcePreset> kSourcePresets[] = {
@@ -111,10 +110,10 @@ struct KindDefaults {
   bool temporal_flat_uniformity = false;
   // Every how many frames temporal frames re-measure the mean ink per covered pixel they are
   // pinned to on a fresh transfer (TemporalSpec::ink_refresh, with ink_ratio 1; 0: no pin), and
-  // whether each pixel moves by the temporal guide's confidence (ink_confident). Not shot-file
-  // keys.
+  // how much each pixel's move follows the temporal guide's confidence (ink_confident). Not
+  // shot-file keys.
   int temporal_ink_refresh = 0;
-  bool temporal_ink_confident = false;
+  float temporal_ink_confident = 0.0f;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

@@ -82,9 +82,21 @@ TEST(ShotFile, KindsSetTheirDefaults) {
     EXPECT_FLOAT_EQ(s.layers[i].temporal.ink_ratio, 1.0f);
     EXPECT_EQ(s.layers[i].temporal.ink_refresh, 8);
   }
-  EXPECT_TRUE(s.layers[2].temporal.ink_confident);  // the shadow's uncovered pixels keep theirs
-  EXPECT_FALSE(s.layers[1].temporal.ink_confident);
+  EXPECT_FLOAT_EQ(s.layers[2].temporal.ink_confident, 1.0f);  // uncovered pixels keep theirs
+  EXPECT_FLOAT_EQ(s.layers[1].temporal.ink_confident, 0.5f);
   EXPECT_FLOAT_EQ(s.layers[0].temporal.ink_ratio, 0.0f);
+  // Hatching: the town's second style, its ink pinned as the shadow's.
+  const pipeline::Layer h =
+      parse_shot(minimal("[layers.h]\nkind = \"hatching\"\nexemplar = \"sphere\"\n"),
+                 "/tmp/shot.toml")
+          .layers[0];
+  ASSERT_EQ(h.guides.size(), 3u);
+  EXPECT_EQ(h.guides[2].pass, "shadow");
+  EXPECT_EQ(h.mask.kind, pipeline::MaskKind::kCovered);
+  EXPECT_EQ(h.look.blend, composite::BlendMode::kMultiply);
+  EXPECT_FLOAT_EQ(h.temporal.weight, 1.0f);
+  EXPECT_EQ(h.temporal.ink_refresh, 8);
+  EXPECT_FLOAT_EQ(h.temporal.ink_confident, 1.0f);
   EXPECT_FLOAT_EQ(parse_shot(minimal("[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"
                                      "uniformity = 2000\n"),
                              "/tmp/shot.toml")
