@@ -422,7 +422,10 @@ class ShotRun {
     const Image<float> other = r == f ? Image<float>() : frames_.passes(r);
     const ImageView<const float> p = r == f ? passes(f).cview() : other.cview();
     AdvectionFields none;
-    const LayerFrame fresh = synthesize_layer(prepared_[i], p, r, nullptr, nullptr, {}, &none, &o_);
+    RunOptions measured_only = o_;  // cancellable, but no error map: the result is only measured
+    measured_only.error_maps = false;
+    const LayerFrame fresh =
+        synthesize_layer(prepared_[i], p, r, nullptr, nullptr, {}, &none, &measured_only);
     ink_refs_[i] = ink_reference(t, fresh.value.cview(), prepared_[i].value_channels, p);
     ink_refs_[i].frame = r;
   }
