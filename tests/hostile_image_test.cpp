@@ -61,6 +61,7 @@ const Case kCases[] = {
     {"exr/display_window_inverted.exr", "display window (10, 10) - (0, 0) is empty or overflows"},
     {"exr/truncated_64x64.exr", "corrupt or truncated image"},
     {"exr/not_an_exr.exr", "not an OpenEXR file"},
+    {"exr/read_before_start.exr", "corrupt or truncated image"},
 };
 
 // Within the default budget (2.56e8 of 2.68e8 pixels) but 3 GB as float: tested on its own.

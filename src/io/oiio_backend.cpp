@@ -9,6 +9,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <type_traits>
@@ -51,11 +52,32 @@ const char* format_for(const std::string& path) {
   return nullptr;
 }
 
+// OpenImageIO's memory reader as the readers see it (its type name and buffer stay), with reads
+// confined to the buffer: the stock one copies from before the buffer when a reader asks at a
+// negative offset, which a damaged EXR makes OpenEXR do (found by fuzz_exr; the reproducer is
+// tests/data/hostile/exr/read_before_start.exr).
+class ConfinedMemReader final : public OIIO::Filesystem::IOMemReader {
+ public:
+  using IOMemReader::IOMemReader;
+  std::size_t read(void* buf, std::size_t size) override {
+    const std::size_t n = pread(buf, size, m_pos);
+    m_pos += int64_t(n);
+    return n;
+  }
+  std::size_t pread(void* buf, std::size_t size, int64_t offset) override {
+    const std::size_t total = m_buf.size();
+    if (offset < 0 || uint64_t(offset) >= total || size == 0) return 0;
+    size = std::min<std::size_t>(size, total - std::size_t(offset));
+    std::memcpy(buf, m_buf.data() + offset, size);
+    return size;
+  }
+};
+
 std::string open_source(const OiioSource& source, Opened& o) {
   const char* format = format_for(source.path);
   if (!format) return "unsupported image format (emaki reads .png, .exr, .tif and .jpg files)";
   if (source.data)
-    o.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(source.data, source.size);
+    o.proxy = std::make_unique<ConfinedMemReader>(source.data, source.size);
   else if (source.file)
     o.proxy =
         std::make_unique<OIIO::Filesystem::IOFile>(source.file, OIIO::Filesystem::IOProxy::Read);
