@@ -6,7 +6,7 @@
 set -e
 cd "$(dirname "$0")/.."
 secs=${1:-60}; shift || true
-targets=${*:-"gltf png exr shot synth_args field script_text farm_state"}
+targets=${*:-"gltf png exr shot synth_args field kept_fields script_text farm_state confine exemplar_index"}
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz -j"$(nproc)" >/dev/null
 for t in $targets; do

@@ -62,6 +62,8 @@ const Case kCases[] = {
     {"exr/truncated_64x64.exr", "corrupt or truncated image"},
     {"exr/not_an_exr.exr", "not an OpenEXR file"},
     {"exr/read_before_start.exr", "corrupt or truncated image"},
+    {"exr/box2i_of_0_bytes.exr",
+     "attribute 'screendisplayWindow' of type box2i has 0 bytes, not 16"},
 };
 
 // Within the default budget (2.56e8 of 2.68e8 pixels) but 3 GB as float: tested on its own.

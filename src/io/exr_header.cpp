@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -239,12 +240,34 @@ class Walker {
       fail("attribute '" + name + "' is not a " + want_type);
   }
 
+  // The value size of OpenEXR's fixed-size attribute types (0: a variable or unknown type).
+  // OpenEXR reads these by their type, whatever size the header gives them, so a wrong size
+  // sends it on a different walk from this one (it read a 1.7 GB attribute size from inside
+  // the next one; found by fuzz_exr, tests/data/hostile/exr/box2i_of_0_bytes.exr).
+  static int32_t fixed_size(const std::string& type) {
+    static const std::pair<const char*, int32_t> kSizes[] = {
+        {"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
+        {"compression", 1}, {"double", 8},   {"envmap", 1},
+        {"float", 4},       {"int", 4},      {"keycode", 28},
+        {"lineOrder", 1},   {"m33f", 36},    {"m33d", 72},
+        {"m44f", 64},       {"m44d", 128},   {"rational", 8},
+        {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
+        {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
+        {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
+    for (const auto& [t, n] : kSizes)
+      if (type == t) return n;
+    return 0;
+  }
+
   void attribute(const std::string& name, Part& p) {
     const std::string type = cstring("attribute type");
     const int32_t size = i32();
     if (size < 0 || uint64_t(size) > in_.left())
       fail("attribute '" + echo(name) + "' claims " + std::to_string(size) +
            " bytes, past the end of the file");
+    if (const int32_t want = fixed_size(type); want > 0 && size != want)
+      fail("attribute '" + echo(name) + "' of type " + type + " has " + std::to_string(size) +
+           " bytes, not " + std::to_string(want));
     if (name == "dataWindow" || name == "displayWindow") {
       expect(name, type, size, "box2i", 16);
       std::array<int32_t, 4> box;
@@ -310,7 +333,10 @@ class Walker {
     for (;;) {
       const std::size_t end = buf.find('\0', at);
       if (end == std::string::npos) fail("channel list is not terminated");
-      if (end == at) break;  // the empty name that ends the list
+      if (end == at) {  // the empty name that ends the list, which OpenEXR reads up to
+        if (end + 1 != buf.size()) fail("channel list does not fill its attribute");
+        break;
+      }
       if (end - at > kMaxName) fail("channel name longer than 255 bytes");
       if (buf.size() - (end + 1) < 16) fail("channel list is truncated");
       int32_t fields[4];

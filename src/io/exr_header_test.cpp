@@ -101,5 +101,27 @@ TEST(ExrHeader, AnEmptyDataWindowIsRefused) {
   EXPECT_NE(refusal(exr), "");
 }
 
+// OpenEXR reads a fixed-size type by its type and a channel list up to its empty name, whatever
+// size the header gives them: a size that says otherwise would send it on another walk.
+TEST(ExrHeader, AnAttributeWhoseSizeIsNotItsTypesIsRefused) {
+  std::vector<unsigned char> exr = small_exr();
+  const std::size_t width = attribute_value(exr, "screenWindowWidth", "float");
+  const int32_t eight = 8;
+  std::memcpy(&exr[width - 4], &eight, 4);
+  EXPECT_EQ(refusal(exr),
+            "EXR header: attribute 'screenWindowWidth' of type float has 8 bytes, not 4");
+}
+
+TEST(ExrHeader, AChannelListShorterThanItsAttributeIsRefused) {
+  std::vector<unsigned char> exr = small_exr();
+  const std::size_t list = attribute_value(exr, "channels", "chlist");
+  int32_t size = 0;
+  std::memcpy(&size, &exr[list - 4], 4);
+  ++size;
+  std::memcpy(&exr[list - 4], &size, 4);
+  exr.insert(exr.begin() + long(list) + size - 1, 0);  // one byte after the list's end
+  EXPECT_EQ(refusal(exr), "EXR header: channel list does not fill its attribute");
+}
+
 }  // namespace
 }  // namespace emaki::io::detail
