@@ -290,13 +290,11 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 }
 
 // The `:key=value` modifiers of a variant: s=SIGMA (temporal guide_sigma; unset: from the frame's
-// size against the painting's), x=X (the warm start's sharp estimate; unset: 0, -1: from that
-// size as the sigma), u=U (temporal
-// uniformity), w=W (temporal weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed),
-// im=SHARE and is=SIGMA (the ink matched to the tone anchor's, TemporalSpec::ink_match), ir=SHARE,
-// ig=PASS, ib=BINS, ic=W, ik=FRAMES (the ink per guide, TemporalSpec::ink_ratio, ink_guide,
-// ink_bins, ink_confident, ink_refresh), fu=U, fr=RADIUS, ft=TOLERANCE (the uniformity of flat
-// areas, TemporalSpec::flat_uniformity, flat).
+// size against the painting's), x=X (warm start's sharp estimate; unset: 0, -1: as the sigma),
+// u=U (uniformity), w=W (weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed), im=SHARE,
+// is=SIGMA (TemporalSpec::ink_match, ink_sigma), ir=SHARE, ig=PASS, ib=BINS, ic=W, ik=FRAMES,
+// io=0|1 (ink_ratio, ink_guide, ink_bins, ink_confident, ink_refresh, ink_objects), fu=U,
+// fr=RADIUS, ft=TOLERANCE (flat_uniformity, flat).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
   for (std::string m; std::getline(ss, m, ':');) {
@@ -341,6 +339,8 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.ink_bins = int(x);
     } else if (key == "ik") {
       l.temporal.ink_refresh = int(x);
+    } else if (key == "io") {
+      l.temporal.ink_objects = x != 0.0f;
     } else if (key == "ic") {
       l.temporal.ink_confident = x;
     } else if (key == "is") {

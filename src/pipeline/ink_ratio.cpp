@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "pipeline/frames.h"
+#include "render/passes.h"
 
 namespace emaki::pipeline {
 
@@ -76,7 +78,92 @@ Inks inks(const InkGuide& g, ImageView<const float> v, int n, const InkReference
   return {s.layer / m, s.expected / m, s.trusted / m};
 }
 
+// The object a pixel shows (render::kObjectId; 0, the background, where the passes have none).
+int object_at(ImageView<const float> passes, int x, int y) {
+  if (passes.channels <= render::kObjectId) return 0;
+  const float* p = passes.at(x, y);
+  return p[render::kAlpha] > 0.5f ? int(std::lround(p[render::kObjectId])) : 0;
+}
+
+bool by_object(const TemporalSpec& t) {
+  return t.ink_objects && t.ink_guide.empty() && t.ink_bins <= 0;
+}
+
+// The mean ink per covered pixel of each object covering at least ink_object_pixels().
+std::vector<std::pair<int, double>> object_inks(ImageView<const float> v, int n,
+                                                ImageView<const float> passes) {
+  std::map<int, std::pair<double, long>> sums;
+  for (int y = 0; y < v.height; ++y)
+    for (int x = 0; x < v.width; ++x)
+      if (covered(v, n, x, y)) {
+        auto& [ink, count] = sums[object_at(passes, x, y)];
+        ink += ink_at(v, n, x, y), ++count;
+      }
+  std::vector<std::pair<int, double>> out;
+  const long fewest = ink_object_pixels(v.width, v.height);
+  for (const auto& [id, s] : sums)
+    if (s.second >= fewest && s.first > kFloor * double(s.second))
+      out.emplace_back(id, s.first / double(s.second));
+  return out;
+}
+
+// pin_ink_ratio with t.ink_objects. Each object `ref` measured gets a factor to its own mean
+// ink, in full once it covers 4 x ink_object_pixels() of the frame and in proportion below that
+// (an object growing or shrinking through the threshold does not jump); the rest of its move,
+// and every other covered pixel's, is the factor of the pixels of the objects `ref` did not
+// measure to the layer's mean ink, or of all the covered pixels when those are too few.
+void pin_by_object(const TemporalSpec& t, int n, ImageView<const float> passes,
+                   const InkReference& ref, Image<float>& value, const Trust& trust) {
+  struct Sums {
+    double layer = 0.0, trusted = 0.0;
+    long pixels = 0;
+    void add(double ink, float trust) { layer += ink, trusted += trust * ink, ++pixels; }
+  };
+  auto expected_of = [&](int id) {
+    for (const auto& [o, ink] : ref.per_object)
+      if (o == id) return ink;
+    return -1.0;
+  };
+  auto share_of = [&](const Sums& g, double expected) {
+    const double m = double(std::max(1L, g.pixels));
+    const double layer = g.layer / m, trusted = g.trusted / m;
+    if (layer <= kFloor || expected <= kFloor || trusted <= kFloor) return 0.0f;
+    return float(t.ink_ratio * (std::clamp(1.0 + (expected - layer) / trusted, 0.5, 2.0) - 1.0));
+  };
+  std::map<int, Sums> objects;
+  Sums rest, all;
+  const ImageView<const float> v = value.cview();
+  for (int y = 0; y < v.height; ++y)
+    for (int x = 0; x < v.width; ++x) {
+      if (!covered(v, n, x, y)) continue;
+      const int id = object_at(passes, x, y);
+      const double ink = ink_at(v, n, x, y);
+      const float tr = trust.at(x, y);
+      all.add(ink, tr);
+      (expected_of(id) >= 0.0 ? objects[id] : rest).add(ink, tr);
+    }
+  const long fewest = ink_object_pixels(v.width, v.height);
+  const float base = share_of(rest.pixels >= fewest ? rest : all, ref.per_bin[0]);
+  std::map<int, float> share;
+  for (const auto& [id, g] : objects) {
+    const float full = std::min(1.0f, float(g.pixels) / float(4 * fewest));
+    share[id] = base + full * (share_of(g, expected_of(id)) - base);
+  }
+  for (int y = 0; y < value.height(); ++y)
+    for (int x = 0; x < value.width(); ++x) {
+      if (!covered(value.cview(), n, x, y)) continue;
+      const auto g = share.find(object_at(passes, x, y));
+      const float scale = 1.0f + trust.at(x, y) * (g != share.end() ? g->second : base);
+      for (int c = 0; c < n; ++c)
+        value(x, y, c) = std::clamp(1.0f - scale * (1.0f - value(x, y, c)), 0.0f, 1.0f);
+    }
+}
+
 }  // namespace
+
+long ink_object_pixels(int width, int height) {
+  return std::max(32L, long(width) * long(height) / 1000);
+}
 
 InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, int n,
                            ImageView<const float> passes) {
@@ -95,6 +182,7 @@ InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, 
   if (g.bins <= 0) {  // the ratio of the means
     if (ink[0] > kFloor * double(count[0]) && guide[0] > kFloor * double(count[0]))
       ref.per_bin = {ink[0] / guide[0]};
+    if (by_object(t) && !ref.per_bin.empty()) ref.per_object = object_inks(value, n, passes);
     return ref;
   }
   // Each bin's mean ink; a bin without pixels takes its nearest bin's that has some.
@@ -124,6 +212,10 @@ void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const fl
   }
   const Trust trust{t.ink_confident > 0.0f && !confidence.empty() ? &confidence : nullptr,
                     std::clamp(t.ink_confident, 0.0f, 1.0f)};
+  if (by_object(t)) {
+    pin_by_object(t, value_channels, passes, ref, value, trust);
+    return;
+  }
   const Inks s = inks(InkGuide(t, passes), value.cview(), value_channels, ref, trust);
   // s.trusted, the ink the factor moves, is its lever.
   if (s.layer <= kFloor || s.expected <= kFloor || s.trusted <= kFloor) return;

@@ -5,9 +5,11 @@
 // factor over the frame) so the ratio comes back to that first frame's. The `shadow` and
 // `outline` kinds have no temporal guide, so the tone anchor does not reach them and their ink
 // walks with the shot's length; frame by frame keeps the mean ink per covered pixel steadier
-// than the chain does, not its ratio to a guide's. Off by default (docs/design/ink-ratio.md).
+// than the chain does, not its ratio to a guide's. The shadow, outline and hatching kinds pin it to
+// fresh transfers (ink_refresh; docs/design/ink-ratio.md); the guides and bins stay off.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "core/image.h"
@@ -21,8 +23,15 @@ namespace emaki::pipeline {
 // layer or its guide has no ink.
 struct InkReference {
   std::vector<double> per_bin;
+  // With TemporalSpec::ink_objects: the mean ink per covered pixel of each object (object id,
+  // ink) that covers at least ink_object_pixels() of the frame, by id.
+  std::vector<std::pair<int, double>> per_object;
   int frame = -1;  // the frame it was measured at, if known
 };
+
+// The fewest covered pixels for an object of a width x height frame to have its own reference
+// and factor: a thousandth of the frame, at least 32.
+long ink_object_pixels(int width, int height);
 
 // With t.ink_refresh > 0, the frame whose fresh transfer sets frame f's reference: the last one
 // ink_refresh frames apart from the chain's first frame `first`. Frames are numbered from the
@@ -38,7 +47,9 @@ InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, 
 // within [1/2, 2], each value clamped to [0, 1]. With t.ink_confident w > 0 and a `confidence`
 // (the temporal guide's), each pixel's ink moves by 1 - w + w x its confidence, the factor set so
 // the mean still comes to what `ref` expects: at w = 1 the pixels the chain did not carry
-// (uncovered ones) keep their ink.
+// (uncovered ones) keep their ink. With t.ink_objects (and no ink guide), each object `ref` has
+// and the frame covers with at least ink_object_pixels() gets its own factor to its own mean
+// ink; the rest of the coverage shares one factor to the layer's mean.
 void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const float> passes,
                    bool chained, InkReference& ref, Image<float>& value,
                    const Image<float>& confidence = {});

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "render/passes.h"
+
 namespace emaki::pipeline {
 namespace {
 
@@ -65,6 +67,55 @@ TEST(InkRatio, RefreshFramesCountFromTheChainsFirstFrame) {
   EXPECT_EQ(ink_reference_frame(t, 10, 17), 10);
   EXPECT_EQ(ink_reference_frame(t, 10, 18), 18);
   EXPECT_EQ(ink_reference_frame(t, 10, 33), 26);
+}
+
+// Passes of a 64x8 frame showing object 2 over columns 0-31, object 3 over 32-60 and object 4
+// over 61-63 (24 pixels: fewer than ink_object_pixels()'s 32).
+Image<float> three_objects() {
+  Image<float> p(64, 8, render::kChannelCount);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 64; ++x)
+      p(x, y, render::kAlpha) = 1.0f, p(x, y, render::kObjectId) = x < 32 ? 2.0f : x < 61 ? 3 : 4;
+  return p;
+}
+
+// Covered everywhere: `left` over columns 0-31, `right` over 32-63.
+Image<float> two_values(float left, float right) {
+  Image<float> im(64, 8, 2);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 64; ++x) im(x, y, 0) = x < 32 ? left : right, im(x, y, 1) = 1.0f;
+  return im;
+}
+
+TEST(InkRatio, EachObjectLargeEnoughKeepsItsOwnInk) {
+  TemporalSpec t;
+  t.ink_ratio = 1.0f;
+  t.ink_objects = true;
+  const Image<float> passes = three_objects();
+  InkReference ref;
+  Image<float> first = two_values(0.6f, 0.8f);  // inks 0.4 and 0.2
+  pin_ink_ratio(t, 1, passes.cview(), false, ref, first);
+  ASSERT_EQ(ref.per_object.size(), 2u);  // object 4 is too small for its own
+  EXPECT_EQ(ref.per_object[0].first, 2);
+  EXPECT_NEAR(ref.per_object[0].second, 0.4, 1e-6);
+  EXPECT_NEAR(ref.per_object[1].second, 0.2, 1e-6);
+  // Object 2 lost half its ink, object 3 kept its (both cover more than 4 x 32 pixels: their own
+  // factors in full): only object 2 is moved, back to 0.4. Object 4 (ink 0.2) has none, and
+  // too few pixels for a factor of its own group: it takes the frame's, to the mean ink 0.3.
+  Image<float> later = two_values(0.8f, 0.8f);
+  pin_ink_ratio(t, 1, passes.cview(), true, ref, later);
+  EXPECT_NEAR(later(3, 3, 0), 0.6f, 1e-6);
+  EXPECT_NEAR(later(40, 3, 0), 0.8f, 1e-6);
+  EXPECT_NEAR(later(62, 3, 0), 0.7f, 1e-6);
+  // One factor over the frame without ink_objects: the mean ink 0.2 goes back to 0.3.
+  t.ink_objects = false;
+  InkReference whole;
+  Image<float> again = two_values(0.6f, 0.8f);
+  pin_ink_ratio(t, 1, passes.cview(), false, whole, again);
+  Image<float> flat = two_values(0.8f, 0.8f);
+  pin_ink_ratio(t, 1, passes.cview(), true, whole, flat);
+  EXPECT_NEAR(flat(3, 3, 0), 0.7f, 1e-6);
+  EXPECT_NEAR(flat(40, 3, 0), 0.7f, 1e-6);
 }
 
 }  // namespace

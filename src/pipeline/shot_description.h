@@ -197,6 +197,9 @@ struct TemporalSpec {
   // transfer of that frame (frame by frame's result), so it follows the shot's own trend; 0: the
   // chain's first frame's alone.
   int ink_refresh = 0;
+  // The reference and the factor per object (the object_id pass) where an object covers enough
+  // of the frame (pipeline/ink_ratio.h); the other pixels share one factor.
+  bool ink_objects = false;
   // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
   // iterations in each.
   int finest_iters = 1;
