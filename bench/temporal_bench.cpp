@@ -18,15 +18,12 @@
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
 // `rest_position_noconf` (temporal_confidence = false); a `_cold` suffix runs the whole pyramid at
-// every frame (temporal_warm_start = false); a `_uniform` suffix keeps the layer's
-// uniformity at temporal frames (temporal_uniformity = uniformity, or --temporal-uniformity U),
-// @W gives the variant the temporal weight W (`rest_position_noconf_uniform@1`: the example
-// before the confidence).
-// --error-*, --foreign-none and --erode set the confidence's parameters
-// (temporal::ConfidenceParams), --temporal-weight the temporal weight of every temporal variant
-// without @W. The judge is ../shared/tools/judge (build it with its build.sh). Its guides are
-// the layer's guides (normal mapped to [0,1], diffuse) with the layer's weights; outside the
-// layer's mask the output is taken as white on every variant alike.
+// every frame (temporal_warm_start = false); a `_uniform` suffix keeps the layer's uniformity at
+// temporal frames (temporal_uniformity = uniformity, or --temporal-uniformity U), @W gives the
+// variant the temporal weight W (`rest_position_noconf_uniform@1`: before the confidence).
+// --error-*, --foreign-none, --erode: temporal::ConfidenceParams; --temporal-weight: every
+// temporal variant's without @W. The judge (../shared/tools/judge, its build.sh) takes the
+// layer's guides and weights; outside the layer's mask every variant's output is white.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -293,7 +290,8 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // size against the painting's), x=X (warm start's sharp estimate; unset: 0, -1: as the sigma),
 // u=U (uniformity), w=W (weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed), im=SHARE,
 // is=SIGMA (TemporalSpec::ink_match, ink_sigma), ir=SHARE, ig=PASS, ib=BINS, ic=W, ik=FRAMES,
-// io=0|1 (ink_ratio, ink_guide, ink_bins, ink_confident, ink_refresh, ink_objects), fu=U,
+// io=0|1, iv=0|1 (ink_ratio, ink_guide, ink_bins, ink_confident, ink_refresh, ink_objects,
+// ink_blend), fu=U,
 // fr=RADIUS, ft=TOLERANCE (flat_uniformity, flat).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
@@ -339,6 +337,8 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.ink_bins = int(x);
     } else if (key == "ik") {
       l.temporal.ink_refresh = int(x);
+    } else if (key == "iv") {
+      l.temporal.ink_blend = x != 0.0f;
     } else if (key == "io") {
       l.temporal.ink_objects = x != 0.0f;
     } else if (key == "ic") {

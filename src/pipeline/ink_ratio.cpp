@@ -203,6 +203,32 @@ int ink_reference_frame(const TemporalSpec& t, int first, int f) {
   return first + (f - first) / t.ink_refresh * t.ink_refresh;
 }
 
+int ink_next_reference_frame(const TemporalSpec& t, int first, int last, int f) {
+  if (!t.ink_blend || t.ink_refresh <= 0) return -1;
+  const int next = ink_reference_frame(t, first, f) + t.ink_refresh;
+  return next <= last ? next : -1;
+}
+
+InkReference blend_ink_references(const InkReference& a, const InkReference& b, double s) {
+  auto mix = [s](double x, double y) { return x + s * (y - x); };
+  InkReference out;
+  if (a.per_bin.size() == b.per_bin.size()) {
+    out.per_bin.resize(a.per_bin.size());
+    for (std::size_t k = 0; k < a.per_bin.size(); ++k)
+      out.per_bin[k] = mix(a.per_bin[k], b.per_bin[k]);
+  } else {
+    out.per_bin = a.per_bin.empty() ? b.per_bin : a.per_bin;
+  }
+  std::map<int, double> objects;  // b's, then a's blended into them or added
+  for (const auto& [id, ink] : b.per_object) objects[id] = ink;
+  for (const auto& [id, ink] : a.per_object) {
+    const auto it = objects.find(id);
+    objects[id] = it == objects.end() ? ink : mix(ink, it->second);
+  }
+  out.per_object.assign(objects.begin(), objects.end());
+  return out;
+}
+
 void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const float> passes,
                    bool chained, InkReference& ref, Image<float>& value,
                    const Image<float>& confidence) {
@@ -229,6 +255,37 @@ void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const fl
       for (int c = 0; c < n; ++c)
         value(x, y, c) = std::clamp(1.0f - scale * (1.0f - value(x, y, c)), 0.0f, 1.0f);
     }
+}
+
+void InkPin::pin(const TemporalSpec& t, int first, int last, int f, bool chained,
+                 int value_channels, ImageView<const float> passes, Image<float>& value,
+                 const Image<float>& confidence, const Measure& measure) {
+  if (chained && t.ink_refresh > 0) refresh(t, first, last, f, measure);
+  pin_ink_ratio(t, value_channels, passes, chained, ref_, value, confidence);
+  if (!chained) {  // a fresh transfer: what a refresh at this frame measures
+    ref_.frame = f;
+    kept_ = {ref_, InkReference{}};
+  }
+}
+
+void InkPin::refresh(const TemporalSpec& t, int first, int last, int f, const Measure& measure) {
+  const int r = ink_reference_frame(t, first, f);
+  if (!t.ink_blend) {
+    if (ref_.frame != r) ref_ = measure(r);
+    return;
+  }
+  const int next = ink_next_reference_frame(t, first, last, f);
+  for (const int k : {r, next})
+    if (k >= 0 && kept_[0].frame != k && kept_[1].frame != k)
+      kept_[kept_[0].frame == r ? 1 : 0] = measure(k);
+  const InkReference& at = kept_[kept_[0].frame == r ? 0 : 1];
+  if (next < 0) {
+    ref_ = at;
+    return;
+  }
+  ref_ = blend_ink_references(at, kept_[kept_[0].frame == next ? 0 : 1],
+                              double(f - r) / double(next - r));
+  ref_.frame = f;
 }
 
 }  // namespace emaki::pipeline

@@ -9,6 +9,8 @@
 // fresh transfers (ink_refresh; docs/design/ink-ratio.md); the guides and bins stay off.
 #pragma once
 
+#include <array>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -37,6 +39,13 @@ long ink_object_pixels(int width, int height);
 // ink_refresh frames apart from the chain's first frame `first`. Frames are numbered from the
 // shot's chain start, not the run's, so a resumed run or a farm chunk measures the same frame.
 int ink_reference_frame(const TemporalSpec& t, int first, int f);
+// With t.ink_blend: the refresh frame after frame f's reference frame, or -1 when it would be
+// after `last` (the shot's last frame) or there is no refresh.
+int ink_next_reference_frame(const TemporalSpec& t, int first, int last, int f);
+// `a` and `b` blended, s of the way to b (0 <= s <= 1): each entry that both have, by that
+// share; one that only one of them has, as it has it.
+InkReference blend_ink_references(const InkReference& a, const InkReference& b, double s);
+
 // `value`: value channels, then its coverage (pixels below 0.5 are left out).
 InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, int value_channels,
                            ImageView<const float> passes);
@@ -53,5 +62,26 @@ InkReference ink_reference(const TemporalSpec& t, ImageView<const float> value, 
 void pin_ink_ratio(const TemporalSpec& t, int value_channels, ImageView<const float> passes,
                    bool chained, InkReference& ref, Image<float>& value,
                    const Image<float>& confidence = {});
+
+// A layer's ink pin along its chain: the reference its frames are pinned to and, with
+// TemporalSpec::ink_blend, the two refresh frames' references it is blended from.
+class InkPin {
+ public:
+  // A fresh transfer of the layer at a frame, measured (ink_reference()).
+  using Measure = std::function<InkReference(int frame)>;
+  // Frame f of a chain from `first` that may run to `last` (the shot's last frame). At the
+  // chain's first frame (`chained` false) measures `value`; at a temporal frame sets the frame's
+  // reference, measuring the refresh frames it needs (once each) through `measure`, and pins
+  // `value` to it (pin_ink_ratio()).
+  void pin(const TemporalSpec& t, int first, int last, int f, bool chained, int value_channels,
+           ImageView<const float> passes, Image<float>& value, const Image<float>& confidence,
+           const Measure& measure);
+  const InkReference& reference() const { return ref_; }
+
+ private:
+  void refresh(const TemporalSpec& t, int first, int last, int f, const Measure& measure);
+  InkReference ref_;
+  std::array<InkReference, 2> kept_;  // measured at refresh frames (ink_blend)
+};
 
 }  // namespace emaki::pipeline

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "render/passes.h"
 
 namespace emaki::pipeline {
@@ -116,6 +118,45 @@ TEST(InkRatio, EachObjectLargeEnoughKeepsItsOwnInk) {
   pin_ink_ratio(t, 1, passes.cview(), true, whole, flat);
   EXPECT_NEAR(flat(3, 3, 0), 0.7f, 1e-6);
   EXPECT_NEAR(flat(40, 3, 0), 0.7f, 1e-6);
+}
+
+// TemporalSpec::ink_blend: each frame's reference is its two refresh frames' blended by its
+// distance to them, each refresh frame measured once; past the last refresh frame before the
+// shot's end, that frame's alone.
+TEST(InkRatio, BlendedReferencesMoveFromOneRefreshToTheNext) {
+  TemporalSpec t;
+  t.ink_ratio = 1.0f;
+  t.ink_refresh = 4;
+  t.ink_blend = true;
+  std::vector<int> measured;
+  const InkPin::Measure measure = [&](int k) {
+    measured.push_back(k);
+    InkReference r;
+    r.per_bin = {0.4 + 0.05 * k};
+    r.frame = k;
+    return r;
+  };
+  InkPin pin;
+  Image<float> first = half_covered(0.6f);  // ink 0.4: frame 0's reference, not measured again
+  pin.pin(t, 0, 10, 0, false, 1, {}, first, {}, measure);
+  const float want[11] = {0.4f, 0.45f, 0.5f, 0.55f, 0.6f, 0.65f,
+                          0.7f, 0.75f, 0.8f, 0.8f,  0.8f};  // frames 8-10: frame 8's
+  for (int f = 1; f <= 10; ++f) {
+    Image<float> v = half_covered(0.5f);  // ink 0.5: every factor within [1/2, 2]
+    pin.pin(t, 0, 10, f, true, 1, {}, v, {}, measure);
+    EXPECT_NEAR(1.0f - v(3, 3, 0), want[f], 1e-5) << f;
+  }
+  EXPECT_EQ(measured, (std::vector<int>{4, 8}));
+  // Entries only one side has are kept as they are.
+  InkReference a, b;
+  a.per_bin = {0.2}, b.per_bin = {0.4};
+  a.per_object = {{2, 0.1}, {3, 0.3}}, b.per_object = {{3, 0.5}, {4, 0.7}};
+  const InkReference m = blend_ink_references(a, b, 0.25);
+  EXPECT_NEAR(m.per_bin[0], 0.25, 1e-12);
+  ASSERT_EQ(m.per_object.size(), 3u);
+  EXPECT_NEAR(m.per_object[0].second, 0.1, 1e-12);
+  EXPECT_NEAR(m.per_object[1].second, 0.35, 1e-12);
+  EXPECT_NEAR(m.per_object[2].second, 0.7, 1e-12);
 }
 
 }  // namespace

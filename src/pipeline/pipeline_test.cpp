@@ -247,7 +247,8 @@ TEST(Pipeline, RunsResumesAndContinuesTheChain) {
 }
 
 // TemporalSpec::ink_refresh: the reference is re-measured on fresh transfers of frames counted
-// from the chain's first, so a run resumed anywhere in the chain makes the same frames.
+// from the chain's first, so a run resumed anywhere in the chain makes the same frames; with
+// ink_blend too (each frame's reference blended between the refresh frames around it).
 TEST(Pipeline, InkRefreshResumesAnywhereWithTheSameFrames) {
   Shot shot = tiny_shot();
   shot.source.last_frame = 5;
@@ -260,18 +261,28 @@ TEST(Pipeline, InkRefreshResumesAnywhereWithTheSameFrames) {
   t.ink_ratio = 1.0f;
   t.ink_confident = 1.0f;
   t.ink_refresh = 2;
-  MemoryStore full;
-  run_shot(shot, frames, ex, CompositeInputs{}, full, o);
-  bool pinned = false;
-  for (int f = 1; f <= 5; ++f) pinned = pinned || !same_layer(plain, full, f);
-  EXPECT_TRUE(pinned);
-  for (int stop : {2, 3}) {  // resumed at a refresh frame's successor (3) and at one (4)
-    MemoryStore part;
-    o.last_frame = stop;
-    run_shot(shot, frames, ex, CompositeInputs{}, part, o);
-    o.last_frame = -1;
-    EXPECT_EQ(run_shot(shot, frames, ex, CompositeInputs{}, part, o).synthesized, 5 - stop);
-    for (int f = 0; f <= 5; ++f) EXPECT_TRUE(same_layer(full, part, f)) << stop << " " << f;
+  MemoryStore stepped;
+  for (bool blend : {false, true}) {
+    SCOPED_TRACE(blend);
+    t.ink_blend = blend;
+    MemoryStore full;
+    run_shot(shot, frames, ex, CompositeInputs{}, full, o);
+    bool pinned = false, blended = false;
+    for (int f = 1; f <= 5; ++f) {
+      pinned = pinned || !same_layer(plain, full, f);
+      blended = blended || (blend && !same_layer(stepped, full, f));
+    }
+    EXPECT_TRUE(pinned);
+    EXPECT_EQ(blended, blend);
+    for (int stop : {2, 3}) {  // resumed at a refresh frame's successor (3) and at one (4)
+      MemoryStore part;
+      o.last_frame = stop;
+      run_shot(shot, frames, ex, CompositeInputs{}, part, o);
+      o.last_frame = -1;
+      EXPECT_EQ(run_shot(shot, frames, ex, CompositeInputs{}, part, o).synthesized, 5 - stop);
+      for (int f = 0; f <= 5; ++f) EXPECT_TRUE(same_layer(full, part, f)) << stop << " " << f;
+    }
+    if (!blend) stepped = std::move(full);
   }
 }
 

@@ -287,7 +287,7 @@ class ShotRun {
       for (const Layer* l : selected_) total_ += needs(*l, f) ? 1 : 0;
     t0_ = Clock::now();
     held_.resize(prepared_.size());
-    ink_refs_.assign(prepared_.size(), {});
+    ink_pins_.assign(prepared_.size(), {});
     for (int f = start; f <= b_; ++f) {
       std::vector<Held> now(prepared_.size());
       const bool changed = synthesize_frame(f, now);
@@ -386,12 +386,10 @@ class ShotRun {
       LayerFrame r = made[i] ? std::move(*made[i])
                              : synthesize_layer(prepared_[i], passes(f).cview(), f, previous,
                                                 previous_passes, previous_nnf, &fields, &o_);
-      if (l.temporal.ink_ratio > 0.0f) {
-        if (previous) refresh_ink_reference(i, f);
-        pin_ink_ratio(l.temporal, prepared_[i].value_channels, passes(f).cview(),
-                      previous != nullptr, ink_refs_[i], r.value, r.confidence);
-        if (!previous) ink_refs_[i].frame = f;
-      }
+      if (l.temporal.ink_ratio > 0.0f)
+        ink_pins_[i].pin(l.temporal, first_, shot_.source.last_frame, f, previous != nullptr,
+                         prepared_[i].value_channels, passes(f).cview(), r.value, r.confidence,
+                         [&](int k) { return measured_ink(i, k, f); });
       if (!r.error.empty())
         store_.write_qa_map("error", l, f,
                             synthesis_error_map(r.error.cview(), r.value.cview(),
@@ -413,12 +411,10 @@ class ShotRun {
     return changed;
   }
 
-  // TemporalSpec::ink_refresh: the reference of layer i's frame f, measured on a fresh transfer
-  // of the frame ink_reference_frame() names (the same in a resumed run or a farm chunk).
-  void refresh_ink_reference(std::size_t i, int f) {
-    const TemporalSpec& t = prepared_[i].layer->temporal;
-    const int r = ink_reference_frame(t, first_, f);
-    if (t.ink_refresh <= 0 || ink_refs_[i].frame == r) return;
+  // TemporalSpec::ink_refresh: the reference measured on a fresh transfer of layer i's frame r,
+  // a frame ink_reference_frame() names (the same in a resumed run or a farm chunk), with the
+  // current frame f's passes or r's read.
+  InkReference measured_ink(std::size_t i, int r, int f) {
     const Image<float> other = r == f ? Image<float>() : frames_.passes(r);
     const ImageView<const float> p = r == f ? passes(f).cview() : other.cview();
     AdvectionFields none;
@@ -426,8 +422,10 @@ class ShotRun {
     measured_only.error_maps = false;
     const LayerFrame fresh =
         synthesize_layer(prepared_[i], p, r, nullptr, nullptr, {}, &none, &measured_only);
-    ink_refs_[i] = ink_reference(t, fresh.value.cview(), prepared_[i].value_channels, p);
-    ink_refs_[i].frame = r;
+    InkReference ref = ink_reference(prepared_[i].layer->temporal, fresh.value.cview(),
+                                     prepared_[i].value_channels, p);
+    ref.frame = r;
+    return ref;
   }
 
   // With RunOptions::concurrent_layers, the layers frame f needs that do not continue a chain
@@ -505,8 +503,8 @@ class ShotRun {
   RunReport report_;
   int total_ = 0;  // layer-frames to synthesize
   Clock::time_point t0_;
-  std::vector<Held> held_;              // parallel to prepared_: each layer's last value
-  std::vector<InkReference> ink_refs_;  // parallel to prepared_ (TemporalSpec::ink_ratio)
+  std::vector<Held> held_;        // parallel to prepared_: each layer's last value
+  std::vector<InkPin> ink_pins_;  // parallel to prepared_ (TemporalSpec::ink_ratio)
   Held prev_passes_;
   std::optional<Image<float>> passes_;  // the current frame's, once read
 };

@@ -200,6 +200,9 @@ struct TemporalSpec {
   // The reference and the factor per object (the object_id pass) where an object covers enough
   // of the frame (pipeline/ink_ratio.h); the other pixels share one factor.
   bool ink_objects = false;
+  // Each frame's reference blended between the refresh frames before and after it (at or
+  // before the shot's last frame) by its distance to them, so it moves without a step.
+  bool ink_blend = false;
   // The warm start's schedule at the finest level: search-vote iterations, and PatchMatch
   // iterations in each.
   int finest_iters = 1;
