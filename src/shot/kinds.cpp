@@ -34,6 +34,10 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       // pixels a moving light uncovers came out lighter (docs/design/ink-ratio.md).
       d.temporal_ink_refresh = 8;
       d.temporal_ink_confident = 1.0f;
+      // One factor per frame left the shadow on each object far from frame by frame's (the
+      // town's Fox 18.5 levels of 255 lighter); per object, with the references blended between
+      // refreshes so that no factor steps, it comes near (docs/design/ink-ratio.md).
+      d.temporal_ink_objects = true;
       break;
     case pipeline::LayerKind::kOutline:
       d.guides = {{"outline", 2.0f}, {"normal", 0.5f}};

@@ -114,6 +114,9 @@ struct KindDefaults {
   // shot-file keys.
   int temporal_ink_refresh = 0;
   float temporal_ink_confident = 0.0f;
+  // Whether the pin is per object, its reference blended between refresh frames
+  // (TemporalSpec::ink_objects and ink_blend; not shot-file keys).
+  bool temporal_ink_objects = false;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

@@ -85,6 +85,9 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_FLOAT_EQ(s.layers[2].temporal.ink_confident, 1.0f);  // uncovered pixels keep theirs
   EXPECT_FLOAT_EQ(s.layers[1].temporal.ink_confident, 0.5f);
   EXPECT_FLOAT_EQ(s.layers[0].temporal.ink_ratio, 0.0f);
+  // The shadow's pin is per object, its references blended between refreshes; not the outline's.
+  EXPECT_TRUE(s.layers[2].temporal.ink_objects && s.layers[2].temporal.ink_blend);
+  EXPECT_FALSE(s.layers[1].temporal.ink_objects || s.layers[1].temporal.ink_blend);
   // Hatching: the town's second style, its ink pinned as the shadow's.
   const pipeline::Layer h =
       parse_shot(minimal("[layers.h]\nkind = \"hatching\"\nexemplar = \"sphere\"\n"),
@@ -97,6 +100,7 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_FLOAT_EQ(h.temporal.weight, 1.0f);
   EXPECT_EQ(h.temporal.ink_refresh, 8);
   EXPECT_FLOAT_EQ(h.temporal.ink_confident, 1.0f);
+  EXPECT_FALSE(h.temporal.ink_objects);
   EXPECT_FLOAT_EQ(parse_shot(minimal("[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"
                                      "uniformity = 2000\n"),
                              "/tmp/shot.toml")
