@@ -286,6 +286,27 @@ TEST(Pipeline, InkRefreshResumesAnywhereWithTheSameFrames) {
   }
 }
 
+// A chain from RunOptions::chain_from (emaki lookdev --temporal) ends with the run: the blend
+// has no refresh frame after it to reach for, so the frame is the one without the blend (and no
+// fresh transfer of a later frame is made for it).
+TEST(Pipeline, APreviewChainBlendsTowardNoLaterFrame) {
+  Shot shot = tiny_shot();
+  shot.source.last_frame = 5;
+  const SlidingFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  TemporalSpec& t = shot.layers[0].temporal;
+  t.ink_ratio = 1.0f;
+  t.ink_refresh = 2;
+  RunOptions o;
+  o.first_frame = o.chain_from = 2;
+  o.last_frame = 3;
+  MemoryStore stepped, blended;
+  run_shot(shot, frames, ex, CompositeInputs{}, stepped, o);
+  t.ink_blend = true;
+  run_shot(shot, frames, ex, CompositeInputs{}, blended, o);
+  EXPECT_TRUE(same_layer(stepped, blended, 3));
+}
+
 TEST(Pipeline, WarmStartResumesFromTheStoredFieldOnly) {
   const Shot shot = tiny_shot();
   const SlidingFrames frames(40, 30);

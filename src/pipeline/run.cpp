@@ -277,6 +277,9 @@ class ShotRun {
           prepare(*l, exemplars.at(l->exemplar), maps, shot.source.width, shot.source.height));
     first_ = o.chain_from < 0 ? shot.source.first_frame
                               : std::clamp(o.chain_from, shot.source.first_frame, a_);
+    // A chain from chain_from (a look-dev preview) ends with the run: its ink pin blends toward
+    // no refresh frame after it, which would cost a fresh transfer of a frame it does not make.
+    chain_last_ = o.chain_from < 0 ? shot.source.last_frame : b_;
   }
 
   RunReport run() {
@@ -387,7 +390,7 @@ class ShotRun {
                              : synthesize_layer(prepared_[i], passes(f).cview(), f, previous,
                                                 previous_passes, previous_nnf, &fields, &o_);
       if (l.temporal.ink_ratio > 0.0f)
-        ink_pins_[i].pin(l.temporal, first_, shot_.source.last_frame, f, previous != nullptr,
+        ink_pins_[i].pin(l.temporal, first_, chain_last_, f, previous != nullptr,
                          prepared_[i].value_channels, passes(f).cview(), r.value, r.confidence,
                          [&](int k) { return measured_ink(i, k, f); });
       if (!r.error.empty())
@@ -496,8 +499,9 @@ class ShotRun {
   const CompositeInputs& ci_;
   Store& store_;
   const RunOptions& o_;
-  int a_ = 0, b_ = 0;  // the requested frames
-  int first_ = 0;      // the shot's first frame
+  int a_ = 0, b_ = 0;   // the requested frames
+  int first_ = 0;       // the shot's first frame
+  int chain_last_ = 0;  // the last frame the chain may reach (TemporalSpec::ink_blend)
   std::vector<const Layer*> selected_;
   std::vector<PreparedLayer> prepared_;  // parallel to selected_
   RunReport report_;
