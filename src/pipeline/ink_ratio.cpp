@@ -119,41 +119,49 @@ void pin_by_object(const TemporalSpec& t, int n, ImageView<const float> passes,
     long pixels = 0;
     void add(double ink, float trust) { layer += ink, trusted += trust * ink, ++pixels; }
   };
-  auto expected_of = [&](int id) {
-    for (const auto& [o, ink] : ref.per_object)
-      if (o == id) return ink;
-    return -1.0;
-  };
   auto share_of = [&](const Sums& g, double expected) {
     const double m = double(std::max(1L, g.pixels));
     const double layer = g.layer / m, trusted = g.trusted / m;
     if (layer <= kFloor || expected <= kFloor || trusted <= kFloor) return 0.0f;
     return float(t.ink_ratio * (std::clamp(1.0 + (expected - layer) / trusted, 0.5, 2.0) - 1.0));
   };
-  std::map<int, Sums> objects;
+  // Each pixel's group: the index of its object in ref.per_object, or -1 (the rest). Looked up
+  // once per run of pixels of one object, not per pixel.
+  std::map<int, int> index;
+  for (std::size_t k = 0; k < ref.per_object.size(); ++k) index[ref.per_object[k].first] = int(k);
+  int last_id = -1, last_group = -1;
+  auto group_at = [&](int x, int y) {
+    const int id = object_at(passes, x, y);
+    if (id != last_id) {
+      const auto it = index.find(id);
+      last_id = id, last_group = it == index.end() ? -1 : it->second;
+    }
+    return last_group;
+  };
+  std::vector<Sums> objects(ref.per_object.size());
   Sums rest, all;
   const ImageView<const float> v = value.cview();
   for (int y = 0; y < v.height; ++y)
     for (int x = 0; x < v.width; ++x) {
       if (!covered(v, n, x, y)) continue;
-      const int id = object_at(passes, x, y);
+      const int g = group_at(x, y);
       const double ink = ink_at(v, n, x, y);
       const float tr = trust.at(x, y);
       all.add(ink, tr);
-      (expected_of(id) >= 0.0 ? objects[id] : rest).add(ink, tr);
+      (g >= 0 ? objects[std::size_t(g)] : rest).add(ink, tr);
     }
   const long fewest = ink_object_pixels(v.width, v.height);
   const float base = share_of(rest.pixels >= fewest ? rest : all, ref.per_bin[0]);
-  std::map<int, float> share;
-  for (const auto& [id, g] : objects) {
-    const float full = std::min(1.0f, float(g.pixels) / float(4 * fewest));
-    share[id] = base + full * (share_of(g, expected_of(id)) - base);
+  std::vector<float> share(objects.size());
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const float full = std::min(1.0f, float(objects[k].pixels) / float(4 * fewest));
+    share[k] = base + full * (share_of(objects[k], ref.per_object[k].second) - base);
   }
   for (int y = 0; y < value.height(); ++y)
     for (int x = 0; x < value.width(); ++x) {
       if (!covered(value.cview(), n, x, y)) continue;
-      const auto g = share.find(object_at(passes, x, y));
-      const float scale = 1.0f + trust.at(x, y) * (g != share.end() ? g->second : base);
+      const int g = group_at(x, y);
+      const float scale = 1.0f + trust.at(x, y) * (g >= 0 ? share[std::size_t(g)] : base);
       for (int c = 0; c < n; ++c)
         value(x, y, c) = std::clamp(1.0f - scale * (1.0f - value(x, y, c)), 0.0f, 1.0f);
     }
