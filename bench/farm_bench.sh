@@ -1,8 +1,10 @@
 #!/bin/bash
-# The bundled production (examples/production: 3 shots at 480x270, 60 frames, 3 layers each):
-# what the farm's tasks cost against `emaki run` of the same shots, in CPU-seconds and wall
-# time per stage, and through Slurm on this machine. Prints figures; asserts nothing.
+# The bundled production (examples/production: 3 shots at 480x270, 60 frames, 3 layers each), or
+# the shots FARM_BENCH_SHOTS names: what the farm's tasks cost against `emaki run` of the same
+# shots, in CPU-seconds and wall time per stage, and through Slurm on this machine. Prints figures; asserts nothing.
 #   bench/farm_bench.sh [EMAKI] [WORK_DIR]      (FARM_BENCH_SLURM=0: leave Slurm out)
+#   FARM_BENCH_SHOTS="examples/fox/shot.toml examples/town/shot.toml" bench/farm_bench.sh
+#     (other shots than the production's, paths from the repository's root)
 # Each run writes its own output folders:
 #   run     `emaki run SHOT --threads 1` for each shot in turn
 #   tasks   the plan's tasks (`--threads 1`) run here one by one, stage by stage, without a
@@ -23,14 +25,24 @@ mkdir -p "$work"
 state=$work/cluster
 trap '[ "$use_slurm" = 1 ] && "$root/scripts/slurm/stop.sh" "$state" >/dev/null 2>&1' EXIT
 
-# The production's shots with absolute paths and their output in $work/$1/.
+# The shots (the production's unless FARM_BENCH_SHOTS names others), each copied to
+# $work/$1/NAME/ beside links to its folder's other files, its "../" paths made absolute and its
+# output folder under $work/$1/NAME/.
+shots=${FARM_BENCH_SHOTS:-$(cd "$root" && echo examples/production/*.toml)}
+shot_name() { local d; d=$(basename "$(dirname "$1")"); echo "$d-$(basename "$1" .toml)"; }
 copy_shots() {
-  mkdir -p "$work/$1"
-  for s in "$root"/examples/production/*.toml; do
-    sed -e "s|\"\.\./|\"$root/examples/|" -e "s|^folder = \"out/|folder = \"$work/$1/|" "$s" \
-      >"$work/$1/$(basename "$s")"
+  local s src dest f
+  for s in $shots; do
+    src=$root/$s dest=$work/$1/$(shot_name "$s")
+    mkdir -p "$dest"
+    for f in "$(dirname "$src")"/*; do
+      case $f in *.toml | */out) ;; *) ln -s "$f" "$dest/" ;; esac
+    done
+    sed -e "s|\"\.\./|\"$(dirname "$(dirname "$src")")/|" \
+      -e "s|^folder = \"out[^\"]*\"|folder = \"$dest/out\"|" "$src" >"$dest/shot.toml"
   done
 }
+shot_files() { echo "$work/$1"/*/shot.toml; }
 now() { date +%s.%N; }
 secs() { awk -v a="$1" -v b="$2" 'BEGIN { print b - a }'; }
 calc() { awk "BEGIN { printf \"%.2f\", $1 }"; }
@@ -48,22 +60,23 @@ outputs_md5() {
 }
 # same DIR_A DIR_B: "identical" when every shot's outputs match byte for byte.
 same() {
-  local r=identical
-  for s in sh010 sh020 sh030; do
-    [ "$(outputs_md5 "$1/$s")" = "$(outputs_md5 "$2/$s")" ] || r="DIFFERENT ($s)"
+  local r=identical s
+  for s in $shots; do
+    s=$(shot_name "$s")
+    [ "$(outputs_md5 "$1/$s/out")" = "$(outputs_md5 "$2/$s/out")" ] || r="DIFFERENT ($s)"
   done
   echo "$r"
 }
 
 copy_shots run
 run_wall=0 run_cpu=0
-for s in "$work"/run/*.toml; do
+for s in $(shot_files run); do
   read -r w c < <(timed "$emaki" run "$s" --threads 1)
   run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
 done
 
 copy_shots tasks
-"$emaki" plan "$work"/tasks/*.toml --chunk $chunk --threads 1 --json >"$work/tasks/plan.json"
+"$emaki" plan $(shot_files tasks) --chunk $chunk --threads 1 --json >"$work/tasks/plan.json"
 tasks=$(grep -c '"id":' "$work/tasks/plan.json")
 declare -A stage_wall stage_cpu stage_n
 for kind in prepare passes layer composite previews; do
@@ -86,7 +99,7 @@ for kind in prepare passes layer composite previews; do
   tasks_cpu=$(calc "$tasks_cpu + ${stage_cpu[$kind]}")
 done
 
-echo "production: 3 shots, 480x270, 60 frames, 3 layers; $tasks tasks (chunk $chunk, 1 thread each)"
+echo "shots: $shots; $tasks tasks (chunk $chunk, 1 thread each)"
 printf '%-34s %9s %9s\n' "" "wall s" "CPU s"
 printf '%-34s %9.1f %9.1f\n' "emaki run of each shot, 1 thread" "$run_wall" "$run_cpu"
 for kind in prepare passes layer composite previews; do
@@ -101,10 +114,10 @@ echo "outputs (but the MP4), tasks vs emaki run: $(same "$work/run" "$work/tasks
 copy_shots slurm
 eval "$("$root/scripts/slurm/start.sh" "$state")"
 t=$(now)
-"$emaki" farm submit "$work"/slurm/*.toml --chunk $chunk 2>/dev/null
+"$emaki" farm submit $(shot_files slurm) --chunk $chunk 2>/dev/null
 while [ -n "$(squeue -h -o %i)" ]; do sleep 0.2; done
 slurm_s=$(secs "$t" "$(now)")
-"$emaki" farm status "$work"/slurm/*.toml --chunk $chunk | tail -n 1
+"$emaki" farm status $(shot_files slurm) --chunk $chunk | tail -n 1
 
 # Dispatch latency: per task, its start minus the end of the last task of the stage before it
 # (its dependency), for tasks that started within 5 s of it (a CPU was free).
@@ -112,7 +125,7 @@ latency=$(/usr/bin/python3 - "$work/slurm" <<'PY'
 import glob, os, sys
 order = ["prepare", "passes", "layer", "composite", "previews"]
 lat = []
-for farm in glob.glob(os.path.join(sys.argv[1], "*", "farm", "status")):
+for farm in glob.glob(os.path.join(sys.argv[1], "*", "out", "farm", "status")):
     stamps = {}
     for f in glob.glob(os.path.join(farm, "*.start")):
         task = os.path.basename(f)[:-6]
@@ -129,7 +142,7 @@ for farm in glob.glob(os.path.join(sys.argv[1], "*", "farm", "status")):
         if 0 <= d < 5: lat.append(d)
 print(f"{sum(lat) / len(lat):.2f} s mean over {len(lat)} tasks" if lat else "n/a")
 cpu = {}
-for farm in glob.glob(os.path.join(sys.argv[1], "*", "farm", "status")):
+for farm in glob.glob(os.path.join(sys.argv[1], "*", "out", "farm", "status")):
     for f in glob.glob(os.path.join(farm, "*.start")):
         end = f[:-6] + ".end"
         k = os.path.basename(f).split(".")[1]

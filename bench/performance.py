@@ -333,7 +333,7 @@ def section_python(a, build, emaki, tmp):
 
 
 SECTIONS = ("synth", "scaling", "memory", "render", "shot", "colour", "run", "temporal",
-            "lookdev", "plan", "python")
+            "lookdev", "plan", "farm", "python")
 TEMPORAL_FRAME = {}  # size -> the shot section's temporal frame seconds
 
 
@@ -391,6 +391,46 @@ def section_plan(a, build):
             "| frames | tasks | task graph s | JSON s | JSON MB |", "|---|---|---|---|---|"] + rows
 
 
+def farm_rows(script, emaki, work, shots):
+    """bench/farm_bench.sh without Slurm on `shots` (None: the production's): the table rows."""
+    env = dict(os.environ, FARM_BENCH_SLURM="0")
+    if shots:
+        env["FARM_BENCH_SHOTS"] = " ".join(shots)
+    out = run_timed(["bash", script, emaki, work], env=env)["out"]
+    run = re.search(r"emaki run of each shot, 1 thread\s+([0-9.]+)\s+([0-9.]+)", out)
+    tasks = re.search(r"the plan's tasks one by one\s+([0-9.]+)\s+([0-9.]+)", out)
+    n = re.search(r"; (\d+) tasks", out)
+    same = re.search(r"tasks vs emaki run: (identical|DIFFERENT.*)", out)
+    if not (run and tasks and n and same):
+        sys.exit(f"performance.py: farm: unexpected output of {script}:\n{out}")
+    what = ", ".join(shots) if shots else "examples/production (3 shots, 480x270, 60 frames)"
+    ratio = float(tasks.group(2)) / float(run.group(2))
+    return [f"| {what} | {n.group(1)} | {float(run.group(2)):.1f} | {float(tasks.group(2)):.1f} "
+            f"| {ratio:.2f}x | {same.group(1)} |"]
+
+
+def section_farm(a, emaki, tmp):
+    script = os.path.join(ROOT, "bench", "farm_bench.sh")
+    rows = farm_rows(script, emaki, os.path.join(tmp, "farm"), None)
+    full = ["examples/fox/shot.toml", "examples/town/shot.toml"]
+    if a.full:
+        rows += farm_rows(script, emaki, os.path.join(tmp, "farm_full"), full)
+    commands = ["FARM_BENCH_SLURM=0 bench/farm_bench.sh"]
+    if a.full:
+        commands.append(f'FARM_BENCH_SLURM=0 FARM_BENCH_SHOTS="{" ".join(full)}" '
+                        "bench/farm_bench.sh")
+    return (["## A production on the farm", "",
+             "The tasks `emaki plan` makes (chunks of 8 frames, 1 thread each), run one by one "
+             "here without a scheduler, against `emaki run --threads 1` of the same shots one "
+             "after another: the CPU-seconds a farm's nodes spend against one process's" +
+             ("" if a.full else " (`--full` adds the bundled examples at full size)") + ":", "",
+             "```sh"] + commands + ["```", "",
+             "| shots | tasks | emaki run CPU s | tasks CPU s | tasks vs run | outputs |",
+             "|---|---|---|---|---|---|"] + rows +
+            ["", "Per stage, and through Slurm on the private test cluster: the script's own "
+             "output."])
+
+
 # Each section's function, called with (args, build folder, emaki, scratch folder).
 SECTION_RUNS = {
     "synth": lambda a, b, e, t: section_synth(a, e, t),
@@ -403,6 +443,7 @@ SECTION_RUNS = {
     "temporal": lambda a, b, e, t: section_temporal(a, b),
     "lookdev": lambda a, b, e, t: section_lookdev(a, b),
     "plan": lambda a, b, e, t: section_plan(a, b),
+    "farm": lambda a, b, e, t: section_farm(a, e, t),
     "python": lambda a, b, e, t: section_python(a, b, e, t),
 }
 
@@ -472,8 +513,8 @@ def main():
         "- `bench/python_overhead.py` (the module's cost over the command line's synthesis, in "
         "instructions with `--instructions`) and `bench/python_gil.py` (two Python threads "
         "synthesizing at once).",
-        "- `bench/farm_bench.sh` (the bundled production's tasks, CPU-seconds and wall time per "
-        "stage, and through Slurm, against `emaki run`) and "
+        "- `bench/farm_bench.sh` with Slurm (the production submitted to the private test "
+        "cluster: its wall time and the scheduler's delay per task) and "
         "`bench/slurm_overhead.sh` (the scheduler's cost per task, [slurm.md](slurm.md)).",
         "- Instruction counts, which other jobs do not disturb: `valgrind --tool=callgrind` of "
         "`emaki synth ... --threads 1` ([design/engine-speed.md](design/engine-speed.md))."]
