@@ -5,9 +5,10 @@
 #   bench/farm_bench.sh [EMAKI] [WORK_DIR]      (FARM_BENCH_SLURM=0: leave Slurm out)
 #   FARM_BENCH_SHOTS="examples/fox/shot.toml examples/town/shot.toml" bench/farm_bench.sh
 #     (other shots than the production's, paths from the repository's root)
-# Each run writes its own output folders:
-#   run     `emaki run SHOT --threads 1` for each shot in turn
-#   tasks   the plan's tasks (`--threads 1`) run here one by one, stage by stage, without a
+#   FARM_BENCH_REPEAT=3 bench/farm_bench.sh  (run and tasks measured 3 times, alternated)
+# Each run writes its own output folders (N: the repetition):
+#   runN    `emaki run SHOT --threads 1` for each shot in turn
+#   tasksN  the plan's tasks (`--threads 1`) run here one by one, stage by stage, without a
 #           scheduler: the work a farm's nodes do, each task's CPU time (user + system) summed
 #           per stage. Its outputs must be byte-identical to `run`'s.
 #   slurm   `emaki farm submit` on the private cluster (scripts/slurm/start.sh), waited for
@@ -68,31 +69,66 @@ same() {
   echo "$r"
 }
 
-copy_shots run
-run_wall=0 run_cpu=0
-for s in $(shot_files run); do
-  read -r w c < <(timed "$emaki" run "$s" --threads 1)
-  run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
-done
-
-copy_shots tasks
-"$emaki" plan $(shot_files tasks) --chunk $chunk --threads 1 --json >"$work/tasks/plan.json"
-tasks=$(grep -c '"id":' "$work/tasks/plan.json")
+# measure_run DIR: `emaki run` of each shot into DIR; adds to run_wall, run_cpu.
+measure_run() {
+  local s w c
+  copy_shots "$1"
+  for s in $(shot_files "$1"); do
+    read -r w c < <(timed "$emaki" run "$s" --threads 1)
+    run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
+  done
+}
+# measure_tasks DIR: the plan's tasks into DIR, stage by stage; adds to stage_wall, stage_cpu.
 declare -A stage_wall stage_cpu stage_n
 for kind in prepare passes layer composite previews; do
   stage_wall[$kind]=0 stage_cpu[$kind]=0 stage_n[$kind]=0
-  while IFS= read -r -d '' line; do
-    eval "set -- $line"
-    read -r w c < <(timed "$@")
-    stage_wall[$kind]=$(calc "${stage_wall[$kind]} + $w")
-    stage_cpu[$kind]=$(calc "${stage_cpu[$kind]} + $c")
-    stage_n[$kind]=$((stage_n[$kind] + 1))
-  done < <(/usr/bin/python3 -c '
+done
+measure_tasks() {
+  local dir=$1 kind line w c  # `set --` below takes the positional parameters
+  copy_shots "$dir"
+  "$emaki" plan $(shot_files "$dir") --chunk $chunk --threads 1 --json >"$work/$dir/plan.json"
+  tasks=$(grep -c '"id":' "$work/$dir/plan.json")
+  for kind in prepare passes layer composite previews; do
+    stage_n[$kind]=0
+    while IFS= read -r -d '' line; do
+      eval "set -- $line"
+      read -r w c < <(timed "$@")
+      stage_wall[$kind]=$(calc "${stage_wall[$kind]} + $w")
+      stage_cpu[$kind]=$(calc "${stage_cpu[$kind]} + $c")
+      stage_n[$kind]=$((stage_n[$kind] + 1))
+    done < <(/usr/bin/python3 -c '
 import json, shlex, sys
 for t in json.load(open(sys.argv[1]))["tasks"]:
     if t["kind"] == sys.argv[2]: sys.stdout.write(" ".join(shlex.quote(a) for a in t["argv"]) + "\0")
-' "$work/tasks/plan.json" "$kind")
+' "$work/$dir/plan.json" "$kind")
+  done
+}
+tasks_cpu_now() {
+  local kind sum=0
+  for kind in prepare passes layer composite previews; do
+    sum=$(calc "$sum + ${stage_cpu[$kind]}")
+  done
+  echo "$sum"
+}
+
+# FARM_BENCH_REPEAT=N measures both N times, alternating which goes first, each into fresh
+# folders: one machine's CPU time moves by more than the ratio's margin from one run to the next.
+reps=${FARM_BENCH_REPEAT:-1}
+run_wall=0 run_cpu=0 ratios="" same_all=identical
+for ((i = 1; i <= reps; i++)); do
+  r0=$run_cpu t0=$(tasks_cpu_now)
+  if ((i % 2)); then
+    measure_run run$i
+    measure_tasks tasks$i
+  else
+    measure_tasks tasks$i
+    measure_run run$i
+  fi
+  ratios="$ratios $(calc "($(tasks_cpu_now) - $t0) / ($run_cpu - $r0)")"
+  r=$(same "$work/run$i" "$work/tasks$i")
+  [ "$r" = identical ] || same_all=$r
 done
+mean() { calc "$1 / $reps"; }
 tasks_wall=0 tasks_cpu=0
 for kind in prepare passes layer composite previews; do
   tasks_wall=$(calc "$tasks_wall + ${stage_wall[$kind]}")
@@ -100,15 +136,22 @@ for kind in prepare passes layer composite previews; do
 done
 
 echo "shots: $shots; $tasks tasks (chunk $chunk, 1 thread each)"
+[ "$reps" = 1 ] || echo "mean of $reps repetitions"
 printf '%-34s %9s %9s\n' "" "wall s" "CPU s"
-printf '%-34s %9.1f %9.1f\n' "emaki run of each shot, 1 thread" "$run_wall" "$run_cpu"
+printf '%-34s %9.1f %9.1f\n' "emaki run of each shot, 1 thread" "$(mean "$run_wall")" \
+  "$(mean "$run_cpu")"
 for kind in prepare passes layer composite previews; do
-  printf '%-34s %9.1f %9.1f\n' "  tasks: $kind (${stage_n[$kind]})" "${stage_wall[$kind]}" \
-    "${stage_cpu[$kind]}"
+  printf '%-34s %9.1f %9.1f\n' "  tasks: $kind (${stage_n[$kind]})" \
+    "$(mean "${stage_wall[$kind]}")" "$(mean "${stage_cpu[$kind]}")"
 done
-printf '%-34s %9.1f %9.1f\n' "the plan's tasks one by one" "$tasks_wall" "$tasks_cpu"
+printf '%-34s %9.1f %9.1f\n' "the plan's tasks one by one" "$(mean "$tasks_wall")" \
+  "$(mean "$tasks_cpu")"
 echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x CPU time"
-echo "outputs (but the MP4), tasks vs emaki run: $(same "$work/run" "$work/tasks")"
+if [ "$reps" != 1 ]; then
+  echo "per repetition:$ratios; median $(printf '%s\n' $ratios | sort -n |
+    awk '{ v[NR] = $1 } END { printf "%.2f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }')"
+fi
+echo "outputs (but the MP4), tasks vs emaki run: $same_all"
 [ "$use_slurm" = 1 ] || exit 0
 
 copy_shots slurm
@@ -153,6 +196,6 @@ print("task seconds: " + ", ".join(f"{k} {n} x {s / n:.1f} s" for k, (n, s) in s
 PY
 )
 printf '%-44s %8.1f s\n' "emaki farm submit on Slurm ($cores cores), to all done" "$slurm_s"
-echo "slurm vs emaki run (1 thread, one shot after another): $(calc "$slurm_s / $run_wall")x wall time"
+echo "slurm vs emaki run (1 thread, one shot after another): $(calc "$slurm_s * $reps / $run_wall")x wall time"
 echo "Slurm's per-task overhead (dispatch after the stage waited for ends): $latency"
-echo "outputs (but the MP4), slurm vs emaki run: $(same "$work/run" "$work/slurm")"
+echo "outputs (but the MP4), slurm vs emaki run: $(same "$work/run1" "$work/slurm")"

@@ -391,9 +391,10 @@ def section_plan(a, build):
             "| frames | tasks | task graph s | JSON s | JSON MB |", "|---|---|---|---|---|"] + rows
 
 
-def farm_rows(script, emaki, work, shots):
-    """bench/farm_bench.sh without Slurm on `shots` (None: the production's): the table rows."""
-    env = dict(os.environ, FARM_BENCH_SLURM="0")
+def farm_rows(a, script, emaki, work, shots):
+    """bench/farm_bench.sh without Slurm on `shots` (None: the production's), a.runs times
+    alternated: the table rows."""
+    env = dict(os.environ, FARM_BENCH_SLURM="0", FARM_BENCH_REPEAT=str(a.runs))
     if shots:
         env["FARM_BENCH_SHOTS"] = " ".join(shots)
     out = run_timed(["bash", script, emaki, work], env=env)["out"]
@@ -404,28 +405,33 @@ def farm_rows(script, emaki, work, shots):
     if not (run and tasks and n and same):
         sys.exit(f"performance.py: farm: unexpected output of {script}:\n{out}")
     what = ", ".join(shots) if shots else "examples/production (3 shots, 480x270, 60 frames)"
-    ratio = float(tasks.group(2)) / float(run.group(2))
+    ratio = f"{float(tasks.group(2)) / float(run.group(2)):.2f}x"
+    reps = re.search(r"per repetition: ([0-9. ]+); median ([0-9.]+)", out)
+    if reps:
+        ratio = f"{reps.group(2)}x ({', '.join(reps.group(1).split())})"
     return [f"| {what} | {n.group(1)} | {float(run.group(2)):.1f} | {float(tasks.group(2)):.1f} "
-            f"| {ratio:.2f}x | {same.group(1)} |"]
+            f"| {ratio} | {same.group(1)} |"]
 
 
 def section_farm(a, emaki, tmp):
     script = os.path.join(ROOT, "bench", "farm_bench.sh")
-    rows = farm_rows(script, emaki, os.path.join(tmp, "farm"), None)
+    rows = farm_rows(a, script, emaki, os.path.join(tmp, "farm"), None)
     full = ["examples/fox/shot.toml", "examples/town/shot.toml"]
     if a.full:
-        rows += farm_rows(script, emaki, os.path.join(tmp, "farm_full"), full)
-    commands = ["FARM_BENCH_SLURM=0 bench/farm_bench.sh"]
+        rows += farm_rows(a, script, emaki, os.path.join(tmp, "farm_full"), full)
+    env = f"FARM_BENCH_SLURM=0 FARM_BENCH_REPEAT={a.runs}"
+    commands = [f"{env} bench/farm_bench.sh"]
     if a.full:
-        commands.append(f'FARM_BENCH_SLURM=0 FARM_BENCH_SHOTS="{" ".join(full)}" '
-                        "bench/farm_bench.sh")
+        commands.append(f'{env} FARM_BENCH_SHOTS="{" ".join(full)}" bench/farm_bench.sh')
     return (["## A production on the farm", "",
              "The tasks `emaki plan` makes (chunks of 8 frames, 1 thread each), run one by one "
              "here without a scheduler, against `emaki run --threads 1` of the same shots one "
-             "after another: the CPU-seconds a farm's nodes spend against one process's" +
+             "after another: the CPU-seconds a farm's nodes spend against one process's; " +
+             ("one run" if a.runs == 1 else f"mean of {a.runs} runs, the two alternated, and "
+              "the median of the runs' ratios") +
              ("" if a.full else " (`--full` adds the bundled examples at full size)") + ":", "",
              "```sh"] + commands + ["```", "",
-             "| shots | tasks | emaki run CPU s | tasks CPU s | tasks vs run | outputs |",
+             "| shots | tasks | emaki run CPU s | tasks CPU s | tasks vs run (each run) | outputs |",
              "|---|---|---|---|---|---|"] + rows +
             ["", "Per stage, and through Slurm on the private test cluster: the script's own "
              "output."])
