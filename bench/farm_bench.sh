@@ -1,7 +1,8 @@
 #!/bin/bash
 # The bundled production (examples/production: 3 shots at 480x270, 60 frames, 3 layers each), or
 # the shots FARM_BENCH_SHOTS names: what the farm's tasks cost against `emaki run` of the same
-# shots, in CPU-seconds and wall time per stage, and through Slurm on this machine. Prints figures; asserts nothing.
+# shots, in CPU-seconds and wall time per stage, and through Slurm on this machine. Prints
+# figures; asserts nothing.
 #   bench/farm_bench.sh [EMAKI] [WORK_DIR]      (FARM_BENCH_SLURM=0: leave Slurm out)
 #   FARM_BENCH_SHOTS="examples/fox/shot.toml examples/town/shot.toml" bench/farm_bench.sh
 #     (other shots than the production's, paths from the repository's root)
@@ -103,10 +104,12 @@ for t in json.load(open(sys.argv[1]))["tasks"]:
 ' "$work/$dir/plan.json" "$kind")
   done
 }
-tasks_cpu_now() {
+# stage_total stage_wall|stage_cpu: the sum over the stages.
+stage_total() {
+  local -n per=$1
   local kind sum=0
   for kind in prepare passes layer composite previews; do
-    sum=$(calc "$sum + ${stage_cpu[$kind]}")
+    sum=$(calc "$sum + ${per[$kind]}")
   done
   echo "$sum"
 }
@@ -116,7 +119,7 @@ tasks_cpu_now() {
 reps=${FARM_BENCH_REPEAT:-1}
 run_wall=0 run_cpu=0 ratios="" same_all=identical
 for ((i = 1; i <= reps; i++)); do
-  r0=$run_cpu t0=$(tasks_cpu_now)
+  r0=$run_cpu t0=$(stage_total stage_cpu)
   if ((i % 2)); then
     measure_run run$i
     measure_tasks tasks$i
@@ -124,16 +127,12 @@ for ((i = 1; i <= reps; i++)); do
     measure_tasks tasks$i
     measure_run run$i
   fi
-  ratios="$ratios $(calc "($(tasks_cpu_now) - $t0) / ($run_cpu - $r0)")"
+  ratios="$ratios $(calc "($(stage_total stage_cpu) - $t0) / ($run_cpu - $r0)")"
   r=$(same "$work/run$i" "$work/tasks$i")
   [ "$r" = identical ] || same_all=$r
 done
 mean() { calc "$1 / $reps"; }
-tasks_wall=0 tasks_cpu=0
-for kind in prepare passes layer composite previews; do
-  tasks_wall=$(calc "$tasks_wall + ${stage_wall[$kind]}")
-  tasks_cpu=$(calc "$tasks_cpu + ${stage_cpu[$kind]}")
-done
+tasks_wall=$(stage_total stage_wall) tasks_cpu=$(stage_total stage_cpu)
 
 echo "shots: $shots; $tasks tasks (chunk $chunk, 1 thread each)"
 [ "$reps" = 1 ] || echo "mean of $reps repetitions"
