@@ -12,34 +12,39 @@ rm -rf "$work" && mkdir -p "$work"
 cp "$src/examples/stylit/source_style.png" "$work/painting.png"
 sed -e "s#\"../data/#\"$src/examples/data/#; s#\"../stylit/source_style.png\"#\"painting.png\"#" \
     -e "s#size = \[960, 540\]#size = [96, 54]#" "$src/examples/fox/shot.toml" > "$work/shot.toml"
+trap 'kill $pid 2>/dev/null || true' EXIT
+# Runs CHECK... every 0.1 s until it succeeds; fails after 300 s, or once lookdev has stopped.
+poll() {  # WHAT CHECK...
+  what=$1; shift
+  i=0
+  until "$@"; do
+    i=$((i + 1))
+    [ $i -lt 3000 ] || { echo "FAIL: no $what within 300 s"; cat "$work/log"; exit 1; }
+    kill -0 $pid 2>/dev/null || { echo "FAIL: lookdev stopped"; cat "$work/log"; exit 1; }
+    sleep 0.1
+  done
+}
 # lookdev picks a free port itself (no --port): the test reads it from the URL printed, so that
 # tests running beside it cannot take it first.
+printed_port() {
+  port=$(sed -n 's#^http://127\.0\.0\.1:\([0-9][0-9]*\)/.*#\1#p' "$work/url")
+  [ -n "$port" ]
+}
 start() {  # lookdev's arguments
-  : > "$work/url"
+  : > "$work/url"  # now, not in the child: the last run's URL must not be read
   "$emaki" lookdev "$@" > "$work/url" 2> "$work/log" &
   pid=$!
-  i=0
-  until port=$(sed -n 's#^http://127\.0\.0\.1:\([0-9][0-9]*\).*#\1#p' "$work/url") &&
-      [ -n "$port" ]; do
-    i=$((i + 1))
-    [ $i -lt 3000 ] || { echo "FAIL: no URL printed within 300 s"; cat "$work/log"; exit 1; }
-    kill -0 $pid 2>/dev/null || { echo "FAIL: lookdev stopped"; cat "$work/log"; exit 1; }
-    sleep 0.1
-  done
+  poll "URL printed" printed_port
 }
 start "$work/shot.toml" --frames 0 --scale 1
-trap 'kill $pid 2>/dev/null || true' EXIT
 status() { curl -s "http://127.0.0.1:$port/api/status" || true; }
-wait_for() {
-  i=0
-  while ! status | grep -q "$1"; do
-    i=$((i + 1))
-    [ $i -lt 3000 ] || { echo "FAIL: no '$1' within 300 s"; cat "$work/log"; exit 1; }
-    kill -0 $pid 2>/dev/null || { echo "FAIL: lookdev stopped"; cat "$work/log"; exit 1; }
-    ! status | grep -q '"message":"error: ' || { echo "FAIL: $(status)"; exit 1; }
-    sleep 0.1
-  done
+# The status shows TEXT; a status with an error message fails the test.
+shows() {
+  status | grep -q "$1" && return 0
+  ! status | grep -q '"message":"error: ' || { echo "FAIL: $(status)"; exit 1; }
+  return 1
 }
+wait_for() { poll "'$1'" shows "$1"; }
 wait_for '"generation":1,'
 grep -q '^http://127.0.0.1:' "$work/url" || { echo "FAIL: no URL printed"; exit 1; }
 frame="$work/out.lookdev/composite/frame_0000.png"
