@@ -169,6 +169,7 @@ struct PixelMove {
 };
 
 inline float occupancy(const Sweep& S, const Band& band, int cx, int cy, const PixelMove& mv) {
+  if (!(S.occ_scale > 0.0f)) return 0.0f;  // no uniformity term: no window sum to look up
   int32_t v = stored_occupancy(S, band, cx, cy);
   if (mv.to_x != mv.from_x || mv.to_y != mv.from_y) {
     const int p = 2 * S.r + 1;
@@ -193,9 +194,11 @@ void mark_dirty(Band& band, int sw, int sh, int cx, int cy, int p) {
 // overlaps their memory latencies.
 inline void prefetch_candidate(const Sweep& S, const Band& band, int cx, int cy) {
   const std::ptrdiff_t i = std::ptrdiff_t(cy) * S.L.sw + cx;
-  __builtin_prefetch(S.occ + i);
-  if (band.dirty[(cy >> kDirtyShift) * band.dirty_stride + (cx >> kDirtyShift)])
-    __builtin_prefetch(band.delta + i);
+  if (S.occ_scale > 0.0f) {
+    __builtin_prefetch(S.occ + i);
+    if (band.dirty[(cy >> kDirtyShift) * band.dirty_stride + (cx >> kDirtyShift)])
+      __builtin_prefetch(band.delta + i);
+  }
   const int16_t* s = S.L.src->at(cx - S.r, cy - S.r);
   const int row_bytes = S.row_elems * int(sizeof(int16_t));
   for (int j = 0; j <= 2 * S.r; ++j) {
@@ -259,6 +262,13 @@ inline void try_set(const Sweep& S, Band& band, const PixelRefs& px, int bx, int
     try_candidate(S, band, px, set[i] % S.L.sw, set[i] / S.L.sw, mv, cur_occ);
 }
 
+// Whether a sweep searches for target pixel (x, y): inside the mask and, without a uniformity
+// term, not matched exactly already (no candidate can cost less than 0; passing the pixel over,
+// its draws skipped, changes no other pixel's draws).
+inline bool searched(const Sweep& S, int x, int y) {
+  return is_active(S.L, x, y) && (S.occ_scale > 0.0f || *S.L.err->at(x, y) != 0.0f);
+}
+
 void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
   const PatchMatchLevel& L = S.L;
   const bool forward = (iter % 2) == 0;
@@ -291,11 +301,11 @@ void sweep_band(const Sweep& S, Band& band, int y0, int y1, int iter) {
   // no other pixel's, and a masked layer (a shadow, an outline) no longer pays for the whole frame.
   for (int y = ys; y != ye; y += q) {
     int cur = 0;
-    if (is_active(L, xs, y)) draw(xs, y, cand[cur]);
+    if (searched(S, xs, y)) draw(xs, y, cand[cur]);
     for (int x = xs; x != xe; x += q) {
       const int next_x = x + q;
-      if (next_x != xe && is_active(L, next_x, y)) draw(next_x, y, cand[cur ^ 1]);
-      if (is_active(L, x, y)) {
+      if (next_x != xe && searched(S, next_x, y)) draw(next_x, y, cand[cur ^ 1]);
+      if (searched(S, x, y)) {
         int32_t* n = L.nnf->at(x, y);
         const PixelRefs px{x,
                            y,
@@ -411,17 +421,16 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
       C.uniformity > 0.0f ? float(C.uniformity / (double(p) * p * omega_best)) : 0.0f;
 
   const int dirty_stride = (L.sw >> kDirtyShift) + 1;
-  DeltaPool pool(std::size_t(L.sw) * L.sh, std::size_t(dirty_stride) * ((L.sh >> kDirtyShift) + 1));
+  // Without a uniformity term no window sum is read and no delta written: none is allocated.
+  DeltaPool pool(occ_scale > 0.0f ? std::size_t(L.sw) * L.sh : 0,
+                 std::size_t(dirty_stride) * ((L.sh >> kDirtyShift) + 1));
   const int band = band_rows(L.th);
   const int bands = (L.th + band - 1) / band;
   static_assert(kRounds >= 2);
   const int rounds = std::min(bands, kRounds);
   // The window sums are computed once; each round's deltas are folded into them afterwards.
   std::vector<int32_t> occ, occ_scratch;
-  if (occ_scale > 0.0f)
-    occupancy_window_sums(L, p, occ, occ_scratch);
-  else
-    occ.assign(std::size_t(L.sw) * L.sh, 0);
+  if (occ_scale > 0.0f) occupancy_window_sums(L, p, occ, occ_scratch);
   const std::vector<int32_t> triangle = triangle_table(p);
   const Sweep sweep{L,
                     C,
