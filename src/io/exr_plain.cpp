@@ -8,11 +8,13 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <mutex>
 
 #define IMATH_HALF_NO_LOOKUP_TABLE  // the conversions inline: no link to libImath
 #include <Imath/half.h>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "io/read_limits.h"
 
 namespace emaki::io::detail {
@@ -411,29 +413,49 @@ std::optional<std::string> encode_plain_exr(ImageView<const float> image,
       plain_header(names, order, options, compression, half, image.width, image.height);
   const int lines = rows_per_chunk(compression);
   const int chunks = (image.height + lines - 1) / lines;
-  const std::size_t table = out.size();
-  out.resize(table + std::size_t(chunks) * 8);
   const std::size_t row_bytes = std::size_t(image.width) * names.size() * (half ? 2 : 4);
-  std::vector<unsigned char> raw(row_bytes * std::size_t(lines)), filtered(raw.size());
-  std::vector<unsigned char> packed(::compressBound(uLong(raw.size())));
+  // Each chunk is packed and compressed on its own, in parallel, into its own bytes; they are
+  // put in order afterwards, so the file is the same byte for byte on any number of threads.
+  std::vector<std::string> pieces(static_cast<std::size_t>(chunks));
+  bool failed = false;
+  std::mutex failure;
+  parallel_for(chunks, 4, [&](int64_t k0, int64_t k1) {
+    std::vector<unsigned char> raw(row_bytes * std::size_t(lines)), filtered(raw.size());
+    std::vector<unsigned char> packed(::compressBound(uLong(raw.size())));
+    for (int64_t k = k0; k < k1; ++k) {
+      const int first = int(k) * lines, rows = std::min(lines, image.height - first);
+      const std::size_t n = row_bytes * std::size_t(rows);
+      pack_rows(image, first, rows, order, half, raw.data());
+      const unsigned char* data = raw.data();
+      std::size_t size = n;
+      if (compression != kNone) {
+        zip_filter(raw.data(), n, filtered.data());
+        uLongf got = uLongf(packed.size());
+        if (::compress2(packed.data(), &got, filtered.data(), uLong(n), kZipLevel) != Z_OK) {
+          const std::lock_guard lock(failure);
+          failed = true;
+          return;
+        }
+        if (got < n) data = packed.data(), size = got;
+      }
+      std::string& piece = pieces[std::size_t(k)];
+      const int32_t prefix[2] = {first, int32_t(size)};
+      piece.reserve(8 + size);
+      piece.append(reinterpret_cast<const char*>(prefix), 8);
+      piece.append(reinterpret_cast<const char*>(data), size);
+    }
+  });
+  if (failed) return std::nullopt;
+  const std::size_t table = out.size();
+  std::size_t total = table + std::size_t(chunks) * 8;
+  for (const std::string& piece : pieces) total += piece.size();
+  out.reserve(total);
+  out.resize(table + std::size_t(chunks) * 8);
   for (int k = 0; k < chunks; ++k) {
-    const int first = k * lines, rows = std::min(lines, image.height - first);
-    const std::size_t n = row_bytes * std::size_t(rows);
-    pack_rows(image, first, rows, order, half, raw.data());
     const uint64_t offset = out.size();
     std::memcpy(out.data() + table + std::size_t(k) * 8, &offset, 8);
-    const unsigned char* data = raw.data();
-    std::size_t size = n;
-    if (compression != kNone) {
-      zip_filter(raw.data(), n, filtered.data());
-      uLongf got = uLongf(packed.size());
-      if (::compress2(packed.data(), &got, filtered.data(), uLong(n), kZipLevel) != Z_OK)
-        return std::nullopt;
-      if (got < n) data = packed.data(), size = got;
-    }
-    const int32_t prefix[2] = {first, int32_t(size)};
-    out.append(reinterpret_cast<const char*>(prefix), 8);
-    out.append(reinterpret_cast<const char*>(data), size);
+    out += pieces[std::size_t(k)];
+    std::string().swap(pieces[std::size_t(k)]);
   }
   return out;
 }
