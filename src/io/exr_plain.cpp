@@ -8,6 +8,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <mutex>
 
 #define IMATH_HALF_NO_LOOKUP_TABLE  // the conversions inline: no link to libImath
@@ -355,6 +356,40 @@ void pack_rows(ImageView<const float> image, int first, int rows, const std::vec
   }
 }
 
+// A chunk's scratch, written before it is read (not zeroed): the packed rows and, under ZIP,
+// the filtered rows and the deflated bytes.
+struct ChunkScratch {
+  ChunkScratch(std::size_t most, bool zip)
+      : bound(zip ? ::compressBound(uLong(most)) : 0),
+        raw(std::make_unique_for_overwrite<unsigned char[]>(most)),
+        filtered(std::make_unique_for_overwrite<unsigned char[]>(zip ? most : 0)),
+        packed(std::make_unique_for_overwrite<unsigned char[]>(bound)) {}
+  uLong bound;
+  std::unique_ptr<unsigned char[]> raw, filtered, packed;
+};
+
+// Rows [first, first + rows) of `image` as a chunk, into `piece`: its first y, its byte count and
+// its rows, ZIP-filtered and deflated (when `s` is a ZIP scratch) unless that comes out no
+// smaller. False when zlib fails.
+bool encode_chunk(ImageView<const float> image, int first, int rows, const std::vector<int>& order,
+                  bool half, std::size_t row_bytes, ChunkScratch& s, std::string& piece) {
+  const std::size_t n = row_bytes * std::size_t(rows);
+  pack_rows(image, first, rows, order, half, s.raw.get());
+  const unsigned char* data = s.raw.get();
+  std::size_t size = n;
+  if (s.bound > 0) {
+    zip_filter(s.raw.get(), n, s.filtered.get());
+    uLongf got = uLongf(s.bound);
+    if (::compress2(s.packed.get(), &got, s.filtered.get(), uLong(n), kZipLevel) != Z_OK)
+      return false;
+    if (got < n) data = s.packed.get(), size = got;
+  }
+  const int32_t prefix[2] = {first, int32_t(size)};
+  piece.assign(reinterpret_cast<const char*>(prefix), 8);
+  piece.append(reinterpret_cast<const char*>(data), size);
+  return true;
+}
+
 }  // namespace
 
 std::optional<AnyImage> read_plain_exr(std::FILE* f, const std::string& path,
@@ -414,49 +449,38 @@ std::optional<std::string> encode_plain_exr(ImageView<const float> image,
   const int lines = rows_per_chunk(compression);
   const int chunks = (image.height + lines - 1) / lines;
   const std::size_t row_bytes = std::size_t(image.width) * names.size() * (half ? 2 : 4);
-  // Each chunk is packed and compressed on its own, in parallel, into its own bytes; they are
-  // put in order afterwards, so the file is the same byte for byte on any number of threads.
-  std::vector<std::string> pieces(static_cast<std::size_t>(chunks));
+  const std::size_t table = out.size();
+  out.resize(table + std::size_t(chunks) * 8);
+  // Chunks are packed and compressed on their own, in parallel, each into its own bytes, and put
+  // in order afterwards, so the file is the same byte for byte on any number of threads. They go
+  // in batches of about kBatchBytes of samples, so that no more than a batch is held twice.
+  constexpr std::size_t kBatchBytes = std::size_t(16) << 20;
+  const int batch = int(std::clamp<std::size_t>(kBatchBytes / (row_bytes * std::size_t(lines) + 1),
+                                                1, std::size_t(chunks)));
+  std::vector<std::string> pieces(static_cast<std::size_t>(batch));
   bool failed = false;
   std::mutex failure;
-  parallel_for(chunks, 4, [&](int64_t k0, int64_t k1) {
-    std::vector<unsigned char> raw(row_bytes * std::size_t(lines)), filtered(raw.size());
-    std::vector<unsigned char> packed(::compressBound(uLong(raw.size())));
-    for (int64_t k = k0; k < k1; ++k) {
-      const int first = int(k) * lines, rows = std::min(lines, image.height - first);
-      const std::size_t n = row_bytes * std::size_t(rows);
-      pack_rows(image, first, rows, order, half, raw.data());
-      const unsigned char* data = raw.data();
-      std::size_t size = n;
-      if (compression != kNone) {
-        zip_filter(raw.data(), n, filtered.data());
-        uLongf got = uLongf(packed.size());
-        if (::compress2(packed.data(), &got, filtered.data(), uLong(n), kZipLevel) != Z_OK) {
+  for (int b0 = 0; b0 < chunks && !failed; b0 += batch) {
+    const int b1 = std::min(chunks, b0 + batch);
+    parallel_for(b1 - b0, compression == kNone ? 8 : 1, [&](int64_t i0, int64_t i1) {
+      ChunkScratch scratch(row_bytes * std::size_t(lines), compression != kNone);
+      for (int64_t i = i0; i < i1; ++i) {
+        const int first = (b0 + int(i)) * lines;
+        if (!encode_chunk(image, first, std::min(lines, image.height - first), order, half,
+                          row_bytes, scratch, pieces[std::size_t(i)])) {
           const std::lock_guard lock(failure);
           failed = true;
           return;
         }
-        if (got < n) data = packed.data(), size = got;
       }
-      std::string& piece = pieces[std::size_t(k)];
-      const int32_t prefix[2] = {first, int32_t(size)};
-      piece.reserve(8 + size);
-      piece.append(reinterpret_cast<const char*>(prefix), 8);
-      piece.append(reinterpret_cast<const char*>(data), size);
+    });
+    for (int k = b0; k < b1 && !failed; ++k) {
+      const uint64_t offset = out.size();
+      std::memcpy(out.data() + table + std::size_t(k) * 8, &offset, 8);
+      out += pieces[std::size_t(k - b0)];
     }
-  });
-  if (failed) return std::nullopt;
-  const std::size_t table = out.size();
-  std::size_t total = table + std::size_t(chunks) * 8;
-  for (const std::string& piece : pieces) total += piece.size();
-  out.reserve(total);
-  out.resize(table + std::size_t(chunks) * 8);
-  for (int k = 0; k < chunks; ++k) {
-    const uint64_t offset = out.size();
-    std::memcpy(out.data() + table + std::size_t(k) * 8, &offset, 8);
-    out += pieces[std::size_t(k)];
-    std::string().swap(pieces[std::size_t(k)]);
   }
+  if (failed) return std::nullopt;
   return out;
 }
 
