@@ -5,11 +5,11 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstdint>
 #include <cstring>
 #include <memory>
-#include <mutex>
 
 #define IMATH_HALF_NO_LOOKUP_TABLE  // the conversions inline: no link to libImath
 #include <Imath/half.h>
@@ -458,8 +458,7 @@ std::optional<std::string> encode_plain_exr(ImageView<const float> image,
   const int batch = int(std::clamp<std::size_t>(kBatchBytes / (row_bytes * std::size_t(lines) + 1),
                                                 1, std::size_t(chunks)));
   std::vector<std::string> pieces(static_cast<std::size_t>(batch));
-  bool failed = false;
-  std::mutex failure;
+  std::atomic<bool> failed = false;
   for (int b0 = 0; b0 < chunks && !failed; b0 += batch) {
     const int b1 = std::min(chunks, b0 + batch);
     parallel_for(b1 - b0, compression == kNone ? 8 : 1, [&](int64_t i0, int64_t i1) {
@@ -468,7 +467,6 @@ std::optional<std::string> encode_plain_exr(ImageView<const float> image,
         const int first = (b0 + int(i)) * lines;
         if (!encode_chunk(image, first, std::min(lines, image.height - first), order, half,
                           row_bytes, scratch, pieces[std::size_t(i)])) {
-          const std::lock_guard lock(failure);
           failed = true;
           return;
         }
