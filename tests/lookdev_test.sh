@@ -40,8 +40,9 @@ start "$work/shot.toml" --frames 0 --scale 1
 status() { curl -s "http://127.0.0.1:$port/api/status" || true; }
 # The status shows TEXT; a status with an error message fails the test.
 shows() {
-  status | grep -q "$1" && return 0
-  ! status | grep -q '"message":"error: ' || { echo "FAIL: $(status)"; exit 1; }
+  now=$(status)
+  case $now in *"$1"*) return 0 ;; esac
+  case $now in *'"message":"error: '*) echo "FAIL: $now"; exit 1 ;; esac
   return 1
 }
 wait_for() { poll "'$1'" shows "$1"; }
