@@ -3,10 +3,9 @@
 // or without the advection's confidence as the temporal guide's weight map, compared on flicker
 // (`emaki qa flicker`'s measure, split into the scene's objects and the static ground, then per
 // object id), on ghosts (`emaki qa ghost`'s measure, against the frame-by-frame variant) and, with
-// --judge, on the independent judge's `style` energy of sampled frames (is the output still made of
-// exemplar texture?) and coverage, and on drift (the mean value of the layer, white outside its
-// mask, 0-255, against frame by frame over the last quarter of the frames: a chain that darkens or
-// fades). Frames stay in memory; only the judge's inputs and --save's PNGs are written.
+// --judge, on the independent judge's `style` energy of sampled frames and coverage, and on drift
+// (the layer's mean value, white outside its mask, 0-255, against frame by frame over the last
+// quarter of the frames). Frames stay in memory; only the judge's inputs and --save's PNGs go out.
 //
 //   temporal_bench [--shot SHOT.toml] [--size WxH (the shot's)] [--frames 48] [--layer base]
 //                  [--variants frame,rest_position_noconf_uniform@1,rest_position,...]
@@ -291,8 +290,7 @@ void print_objects(const pipeline::Shot& shot, const std::vector<Variant>& varia
 // u=U (uniformity), w=W (weight), c=FULL/NONE (the guide-change ramp), r=0|1 (reseed), im=SHARE,
 // is=SIGMA (TemporalSpec::ink_match, ink_sigma), ir=SHARE, ig=PASS, ib=BINS, ic=W, ik=FRAMES,
 // io=0|1, iv=0|1 (ink_ratio, ink_guide, ink_bins, ink_confident, ink_refresh, ink_objects,
-// ink_blend), fu=U,
-// fr=RADIUS, ft=TOLERANCE (flat_uniformity, flat).
+// ink_blend), fu=U, fr=RADIUS, ft=TOLERANCE (flat_uniformity, flat), cr=R (coherence_radius).
 void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
   std::stringstream ss(variant.substr(std::min(variant.size(), variant.find(':'))));
   for (std::string m; std::getline(ss, m, ':');) {
@@ -355,6 +353,8 @@ void apply_modifiers(pipeline::Layer& l, const std::string& variant) {
       l.temporal.anchor_finest_iters = int(x);
     } else if (key == "pm") {
       l.temporal.warm_patch_match_iters = int(x);
+    } else if (key == "cr") {
+      l.temporal.coherence_radius = int(x);
     } else {
       usage("bad modifier " + m);
     }

@@ -205,7 +205,8 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     params.finest_search_vote_iters = l.temporal.finest_iters;
     const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;
     if (l.temporal.warm_start && field && !previous_nnf.empty()) {
-      warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor.nnf);
+      warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor.nnf,
+                        p.sharpening.coherence_radius);
       params.initial_nnf = warm.cview();
       params.warm_sharp_estimate = p.sharpening.sharp_estimate;
       warm_schedule(l.synth, l.temporal, params);

@@ -161,6 +161,12 @@ struct TemporalSpec {
   // grain but flickers more and breaks the hatching's strokes up
   // (docs/design/temporal-sharpening.md).
   float sharp_estimate = 0.0f;
+  // The carried field's offsets snapped to the most common one over a (2 r + 1)^2 window
+  // (temporal::coherent_field) before the warm start: where the surface turns on screen the
+  // carried patches drift apart and the vote blurs them. 0: off. Negative: 3 x the share
+  // temporal_sharpening() takes from the frame's size against the painting's, rounded (the
+  // `base` kind's default; docs/design/long-shots.md#the-grain-under-a-turning-camera).
+  int coherence_radius = 0;
   // A warm start drops the carried field where the temporal guide has no confidence (surface
   // hidden at t-1, the layer's guides changed): those pixels are searched afresh.
   bool reseed = false;

@@ -1,11 +1,13 @@
 #include "pipeline/temporal_guide.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "pipeline/frames.h"
 #include "render/passes.h"
+#include "temporal/coherent_field.h"
 
 namespace emaki::pipeline {
 
@@ -31,7 +33,8 @@ TemporalSharpening temporal_sharpening(const TemporalSpec& t, int frame_width, i
   const float k =
       t.weight > 0.0f ? float(std::clamp((share - 0.12) / (0.40 - 0.12), 0.0, 1.0)) : 0.0f;
   return {t.guide_sigma >= 0.0f ? t.guide_sigma : k,
-          t.sharp_estimate >= 0.0f ? t.sharp_estimate : k};
+          t.sharp_estimate >= 0.0f ? t.sharp_estimate : k,
+          t.coherence_radius >= 0 ? t.coherence_radius : int(std::lround(3.0f * k))};
 }
 
 void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>& guides,
@@ -126,8 +129,10 @@ Image<int32_t> carry_field(ImageView<const int32_t> previous, const temporal::Ad
 
 Image<int32_t> warm_field(const Layer& l, ImageView<const int32_t> previous,
                           const temporal::AdvectionField& field, const Image<float>& confidence,
-                          const Image<int32_t>& fresh) {
+                          const Image<int32_t>& fresh, int coherence_radius) {
   Image<int32_t> warm = carry_field(previous, field);
+  if (coherence_radius > 0 && !warm.empty())
+    warm = temporal::coherent_field(warm.cview(), coherence_radius);
   if ((!l.temporal.reseed && fresh.empty()) || warm.empty() || confidence.empty()) return warm;
   parallel_rows(warm.height(), 32, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)

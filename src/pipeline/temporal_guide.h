@@ -35,6 +35,7 @@ uint64_t frame_seed(const Layer& l, int frame, int transfer);
 struct TemporalSharpening {
   float guide_sigma = 0.0f;
   float sharp_estimate = 0.0f;
+  int coherence_radius = 0;  // TemporalSpec::coherence_radius: 3 x that share, rounded
 };
 TemporalSharpening temporal_sharpening(const TemporalSpec& t, int frame_width, int frame_height,
                                        int painting_width, int painting_height);
@@ -107,12 +108,13 @@ Image<int32_t> carry_field(ImageView<const int32_t> previous,
 // value clamped to [0, 1]. Empty when the layer has none.
 Image<float> change_guides(const Layer& layer, ImageView<const float> passes);
 
-// carry_field() with the entries dropped where the temporal guide has no `confidence`: drawn
-// afresh (TemporalSpec::reseed), or, when `fresh` (the tone anchor's field at full size) is not
-// empty, taken from it.
+// carry_field(), made coherent over `coherence_radius` (temporal::coherent_field), with the
+// entries dropped where the temporal guide has no `confidence`: drawn afresh
+// (TemporalSpec::reseed), or, when `fresh` (the tone anchor's field at full size) is not empty,
+// taken from it.
 Image<int32_t> warm_field(const Layer& layer, ImageView<const int32_t> previous,
                           const temporal::AdvectionField& field, const Image<float>& confidence,
-                          const Image<int32_t>& fresh);
+                          const Image<int32_t>& fresh, int coherence_radius = 0);
 
 // The main transfer's schedule with a warm start, unless the layer sets its own counts.
 void warm_schedule(const SynthSpec& s, const TemporalSpec& t, synth::Params& p);

@@ -43,6 +43,21 @@ TEST(TemporalSharpening, ALayerWithoutATemporalGuideOrWithItsOwnKeysKeepsThem) {
   EXPECT_EQ(s.sharp_estimate, 0.0f);
 }
 
+TEST(TemporalSharpening, CoherenceRadiusGrowsWithTheShare) {
+  TemporalSpec t;
+  EXPECT_EQ(temporal_sharpening(t, 960, 540, 1200, 912).coherence_radius, 0);  // off by default
+  t.coherence_radius = -1;                                                     // the base kind's
+  EXPECT_EQ(temporal_sharpening(t, 480, 270, 1200, 912).coherence_radius, 0);
+  EXPECT_EQ(temporal_sharpening(t, 640, 360, 1200, 912).coherence_radius, 1);  // 3 x 0.32
+  EXPECT_EQ(temporal_sharpening(t, 960, 540, 1200, 912).coherence_radius, 3);
+  EXPECT_EQ(temporal_sharpening(t, 480, 270, 600, 456).coherence_radius, 3);
+  t.weight = 0.0f;
+  EXPECT_EQ(temporal_sharpening(t, 960, 540, 1200, 912).coherence_radius, 0);
+  t.weight = 1.0f;
+  t.coherence_radius = 2;
+  EXPECT_EQ(temporal_sharpening(t, 480, 270, 1200, 912).coherence_radius, 2);
+}
+
 // temporal_uniformity(): the kind's flat-area uniformity joins the main transfer's as a map over
 // the large flat areas of the layer's guides, and nothing changes where there are none.
 TEST(TemporalUniformity, AddsTheFlatAreasTermAsAMap) {

@@ -9,6 +9,11 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       d.guides = {{"normal", 1.0f}, {"diffuse", 1.0f}};
       d.mask = {pipeline::MaskKind::kCovered, 0.0f, 0.5f};
       d.look.source = composite::ColorSource::kAlbedo;
+      // Under a turning camera the carried patches drift apart and the vote blurs the grain
+      // away (0.62x of frame by frame's texture on the Fox at 960x540); snapped back side by
+      // side the chain keeps it, for some flicker; on the hatching's strokes it cost both
+      // (docs/design/long-shots.md).
+      d.temporal_coherence = true;
       break;
     case pipeline::LayerKind::kShadow:
       d.guides = {{"diffuse", 1.0f}, {"shadow", 1.0f}};

@@ -117,6 +117,10 @@ struct KindDefaults {
   // Whether the pin is per object, its reference blended between refresh frames
   // (TemporalSpec::ink_objects and ink_blend; not shot-file keys).
   bool temporal_ink_objects = false;
+  // Whether the warm start's carried field is made coherent again over a window that grows with
+  // the frame's size against the painting's (TemporalSpec::coherence_radius -1; not a shot-file
+  // key).
+  bool temporal_coherence = false;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

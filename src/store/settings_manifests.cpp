@@ -173,10 +173,10 @@ Manifest layer_manifest(const pipeline::Shot& shot, const pipeline::Layer& layer
   const pipeline::TemporalSpec& t = layer.temporal;
   l.add(p + "temporal.chain",
         fmt::format("guide_sigma {} sharp {} reseed {} change {} {} anchor {} sigma {} rate {} "
-                    "holes {} finest {} schedule {} {}",
+                    "holes {} finest {} schedule {} {} coherence {}",
                     t.guide_sigma, t.sharp_estimate, t.reseed, c.change_full, c.change_none,
                     t.anchor, t.anchor_sigma, t.anchor_rate, t.anchor_holes, t.anchor_finest_iters,
-                    t.finest_iters, t.warm_patch_match_iters));
+                    t.finest_iters, t.warm_patch_match_iters, t.coherence_radius));
   l.add(p + "mask", fmt::format("{} dilate {} threshold {}", int(layer.mask.kind),
                                 layer.mask.dilate, layer.mask.threshold));
   return l.m;

@@ -1,0 +1,106 @@
+// coherent_field(): the carried field's offsets snapped to the most common one around each pixel.
+#include "temporal/coherent_field.h"
+
+#include <gtest/gtest.h>
+
+#include "core/parallel.h"
+
+namespace emaki::temporal {
+namespace {
+
+constexpr int kW = 40, kH = 30;
+
+// Every pixel at (x + dx, y + dy), except a band of rows that a turn has shifted by one: the
+// staircase a carried field takes when the surface turns on screen.
+Image<int32_t> staircase() {
+  Image<int32_t> f(kW, kH, 2);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      f(x, y, 0) = x + 100 + (y % 6 == 0 ? 1 : 0);
+      f(x, y, 1) = y + 50;
+    }
+  return f;
+}
+
+TEST(CoherentField, SnapsAStaircaseToOneOffset) {
+  const Image<int32_t> out = coherent_field(staircase().cview(), 2);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      ASSERT_EQ(out(x, y, 0), x + 100) << x << "," << y;
+      ASSERT_EQ(out(x, y, 1), y + 50) << x << "," << y;
+    }
+}
+
+TEST(CoherentField, KeepsACoherentFieldAndItsPieces) {
+  // Two pieces side by side, each wider than the window: every pixel keeps its own offset.
+  Image<int32_t> f(kW, kH, 2);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      f(x, y, 0) = x < 20 ? x + 3 : x + 200;
+      f(x, y, 1) = x < 20 ? y + 7 : y - 4;
+    }
+  const Image<int32_t> out = coherent_field(f.cview(), 2);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      ASSERT_EQ(out(x, y, 0), f(x, y, 0));
+      ASSERT_EQ(out(x, y, 1), f(x, y, 1));
+    }
+}
+
+TEST(CoherentField, RadiusZeroChangesNothing) {
+  const Image<int32_t> f = staircase();
+  const Image<int32_t> out = coherent_field(f.cview(), 0);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) ASSERT_EQ(out(x, y, 0), f(x, y, 0));
+}
+
+TEST(CoherentField, PixelsWithoutAPatchStayAndDoNotVote) {
+  Image<int32_t> f = staircase();
+  // A hole of (-1, -1) entries around (10, 12), and the row above it shifted: the hole's pixels
+  // stay empty, and (10, 11)'s window, half hole, is still won by the field's own offset.
+  for (int y = 12; y < 16; ++y)
+    for (int x = 8; x < 13; ++x) f(x, y, 0) = f(x, y, 1) = -1;
+  const Image<int32_t> out = coherent_field(f.cview(), 1);
+  EXPECT_EQ(out(10, 13, 0), -1);
+  EXPECT_EQ(out(10, 13, 1), -1);
+  EXPECT_EQ(out(10, 12, 0), -1);
+  EXPECT_EQ(out(10, 11, 0), 110);
+}
+
+TEST(CoherentField, TiesKeepTheOwnOffset) {
+  // Two columns, each its own offset: every 3x3 window, cut by the border, holds as many pixels
+  // of each, so every pixel keeps its own.
+  Image<int32_t> f(2, 3, 2);
+  for (int y = 0; y < 3; ++y) {
+    f(0, y, 0) = 10, f(1, y, 0) = 41;
+    f(0, y, 1) = f(1, y, 1) = y;
+  }
+  const Image<int32_t> out = coherent_field(f.cview(), 1);
+  for (int y = 0; y < 3; ++y) {
+    EXPECT_EQ(out(0, y, 0), 10);
+    EXPECT_EQ(out(1, y, 0), 41);
+  }
+}
+
+TEST(CoherentField, SameResultWithOneThread) {
+  Image<int32_t> f(kW, kH, 2);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      f(x, y, 0) = x + (x * 7 + y * 13) % 3;  // noisy offsets: many ties and changes
+      f(x, y, 1) = y + (x * 5 + y * 3) % 2;
+    }
+  const Image<int32_t> many = coherent_field(f.cview(), 2);
+  Image<int32_t> one;
+  {
+    ScopedThreadCount single(1);
+    one = coherent_field(f.cview(), 2);
+  }
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      ASSERT_EQ(one(x, y, 0), many(x, y, 0));
+      ASSERT_EQ(one(x, y, 1), many(x, y, 1));
+    }
+}
+
+}  // namespace
+}  // namespace emaki::temporal
