@@ -1,5 +1,6 @@
 #include "temporal/coherent_field.h"
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -8,31 +9,46 @@
 namespace emaki::temporal {
 namespace {
 
+// An offset (patch centre minus position) as one key, and how many pixels of a window have it.
 struct Offset {
-  int32_t dx = 0, dy = 0;
+  int64_t key = 0;
   int count = 0;
 };
 
+int64_t offset_key(ImageView<const int32_t> f, int x, int y) {
+  return int64_t(uint64_t(uint32_t(f(x, y, 0) - x)) << 32 | uint32_t(f(x, y, 1) - y));
+}
+
 // The offset pixel (x, y) takes: see coherent_field().
-Offset snapped_offset(ImageView<const int32_t> f, int x, int y, int r, std::vector<Offset>& seen) {
+int64_t snapped_offset(ImageView<const int32_t> f, int x, int y, int r, std::vector<Offset>& seen) {
+  const int64_t own = offset_key(f, x, y);
+  const int x0 = std::max(0, x - r), x1 = std::min(f.width - 1, x + r);
+  const int y0 = std::max(0, y - r), y1 = std::min(f.height - 1, y + r);
+  // First the pixels that share the own offset: when they are at least half of the window's
+  // pixels with a patch, no other offset can have more of them.
+  int own_count = 0, valid = 0;
+  for (int yy = y0; yy <= y1; ++yy)
+    for (int xx = x0; xx <= x1; ++xx)
+      if (f(xx, yy, 0) >= 0) {
+        ++valid;
+        own_count += offset_key(f, xx, yy) == own;
+      }
+  if (2 * own_count >= valid) return own;
   seen.clear();
-  const Offset own{f(x, y, 0) - x, f(x, y, 1) - y, 0};
-  for (int yy = std::max(0, y - r); yy <= std::min(f.height - 1, y + r); ++yy)
-    for (int xx = std::max(0, x - r); xx <= std::min(f.width - 1, x + r); ++xx) {
+  for (int yy = y0; yy <= y1; ++yy)
+    for (int xx = x0; xx <= x1; ++xx) {
       if (f(xx, yy, 0) < 0) continue;
-      const int32_t dx = f(xx, yy, 0) - xx, dy = f(xx, yy, 1) - yy;
+      const int64_t k = offset_key(f, xx, yy);
       Offset* o = nullptr;
       for (Offset& s : seen)
-        if (s.dx == dx && s.dy == dy) o = &s;
-      if (!o) o = &seen.emplace_back(Offset{dx, dy, 0});
+        if (s.key == k) o = &s;
+      if (!o) o = &seen.emplace_back(Offset{k, 0});
       ++o->count;
     }
-  Offset best = own;
-  for (const Offset& s : seen)
-    if (s.dx == own.dx && s.dy == own.dy) best.count = s.count;
+  Offset best{own, own_count};
   for (const Offset& s : seen)
     if (s.count > best.count) best = s;
-  return best;
+  return best.key;
 }
 
 }  // namespace
@@ -47,9 +63,9 @@ Image<int32_t> coherent_field(ImageView<const int32_t> field, int radius) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < field.width; ++x) {
         if (field(x, y, 0) < 0) continue;
-        const Offset o = snapped_offset(field, x, y, radius, seen);
-        out(x, y, 0) = x + o.dx;
-        out(x, y, 1) = y + o.dy;
+        const int64_t o = snapped_offset(field, x, y, radius, seen);
+        out(x, y, 0) = x + int32_t(uint32_t(uint64_t(o) >> 32));
+        out(x, y, 1) = y + int32_t(uint32_t(uint64_t(o)));
       }
   });
   return out;
