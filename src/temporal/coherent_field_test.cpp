@@ -10,8 +10,8 @@ namespace {
 
 constexpr int kW = 40, kH = 30;
 
-// Every pixel at (x + dx, y + dy), except a band of rows that a turn has shifted by one: the
-// staircase a carried field takes when the surface turns on screen.
+// Every pixel at (x + 100, y + 50), but every sixth row shifted by one pixel: the steps a carried
+// field takes when the surface turns on screen.
 Image<int32_t> staircase() {
   Image<int32_t> f(kW, kH, 2);
   for (int y = 0; y < kH; ++y)
