@@ -56,8 +56,8 @@ TEST(CoherentField, RadiusZeroChangesNothing) {
 
 TEST(CoherentField, PixelsWithoutAPatchStayAndDoNotVote) {
   Image<int32_t> f = staircase();
-  // A hole of (-1, -1) entries around (10, 12), and the row above it shifted: the hole's pixels
-  // stay empty, and (10, 11)'s window, half hole, is still won by the field's own offset.
+  // A hole of (-1, -1) entries over rows 12-15, columns 8-12: its pixels stay empty, and
+  // (10, 11), whose 3x3 window is one third hole, keeps the offset the rest of its window has.
   for (int y = 12; y < 16; ++y)
     for (int x = 8; x < 13; ++x) f(x, y, 0) = f(x, y, 1) = -1;
   const Image<int32_t> out = coherent_field(f.cview(), 1);
