@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+#include <utility>
+#include <vector>
+
 #include "core/parallel.h"
 
 namespace emaki::temporal {
@@ -79,6 +83,71 @@ TEST(CoherentField, TiesKeepTheOwnOffset) {
   for (int y = 0; y < 3; ++y) {
     EXPECT_EQ(out(0, y, 0), 10);
     EXPECT_EQ(out(1, y, 0), 41);
+  }
+}
+
+// The header's definition, pixel by pixel and window by window, with nothing shared between
+// pixels: what the sliding counts of coherent_field() must give.
+Image<int32_t> by_definition(const Image<int32_t>& f, int r) {
+  Image<int32_t> out = f.clone();
+  for (int y = 0; y < f.height(); ++y)
+    for (int x = 0; x < f.width(); ++x) {
+      if (f(x, y, 0) < 0) continue;
+      const std::pair<int, int> own{f(x, y, 0) - x, f(x, y, 1) - y};
+      std::vector<std::pair<std::pair<int, int>, int>> met;  // offsets in row order, counts
+      for (int yy = std::max(0, y - r); yy <= std::min(f.height() - 1, y + r); ++yy)
+        for (int xx = std::max(0, x - r); xx <= std::min(f.width() - 1, x + r); ++xx) {
+          if (f(xx, yy, 0) < 0) continue;
+          const std::pair<int, int> o{f(xx, yy, 0) - xx, f(xx, yy, 1) - yy};
+          bool found = false;
+          for (auto& m : met)
+            if (m.first == o) ++m.second, found = true;
+          if (!found) met.push_back({o, 1});
+        }
+      std::pair<int, int> best = own;
+      int best_count = 0;
+      for (const auto& m : met)
+        if (m.first == own) best_count = m.second;
+      for (const auto& m : met)
+        if (m.second > best_count) best = m.first, best_count = m.second;
+      out(x, y, 0) = x + best.first;
+      out(x, y, 1) = y + best.second;
+    }
+  return out;
+}
+
+// Random fields of pieces (runs of one offset along rows, some continued from the row above),
+// pixels without a patch among them, at several radii: the same as the definition everywhere.
+TEST(CoherentField, MatchesItsDefinitionOnRandomFields) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 24; ++trial) {
+    const int w = 23 + trial * 3, h = 17 + trial * 2, r = 1 + trial % 6;
+    Image<int32_t> f(w, h, 2);
+    int dx = 0, dy = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const unsigned roll = rng() % 100;
+        if (roll < 8) {
+          f(x, y, 0) = -1;
+          f(x, y, 1) = -1;
+          continue;
+        }
+        if (roll < 30) {
+          dx = int(rng() % 5) - 2;
+          dy = int(rng() % 5) - 2;
+        } else if (roll < 45 && y > 0 && f(x, y - 1, 0) >= 0) {
+          dx = f(x, y - 1, 0) - x;
+          dy = f(x, y - 1, 1) - (y - 1);
+        }
+        f(x, y, 0) = x + 50 + dx;
+        f(x, y, 1) = y + 50 + dy;
+      }
+    const Image<int32_t> want = by_definition(f, r), got = coherent_field(f.cview(), r);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        ASSERT_EQ(got(x, y, 0), want(x, y, 0)) << trial << ": " << x << "," << y;
+        ASSERT_EQ(got(x, y, 1), want(x, y, 1)) << trial << ": " << x << "," << y;
+      }
   }
 }
 
