@@ -230,8 +230,7 @@ struct Variant {
   std::map<int, bench::ToneTexture> tone_by_id;  // `tone` per object id
 };
 
-// A guide value that moves by no more than this between frames counts as the same light.
-constexpr float kLightTolerance = 0.02f;
+constexpr float kLightTolerance = 0.02f;  // a guide moving no more between frames: same light
 
 std::string object_name(const pipeline::Shot& shot, int id) {
   std::string name = id == 1 ? "ground" : "object";
@@ -529,8 +528,8 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
 // Against frame by frame, same pixels: tone drift and texture kept inside the mask over the last
 // quarter, and both again over the pixels disoccluded within the last few frames (the wash).
 void print_tone_table(const std::vector<Variant>& variants) {
-  // flicker held: the flicker where the light held (bench::light_held) against frame by frame's
-  // there: the chain's own, without what a moving light or shadow changes.
+  // flicker held: where the light held within a patch's reach (bench::light_held), against frame
+  // by frame's there: the chain's own, without what a moving light, shadow or silhouette changes.
   const double held_ref = variants[0].held_flicker.all.mean();
   std::printf("\n%-24s %9s %9s %11s %11s %12s %13s\n", "variant", "tone", "texture", "wash tone",
               "wash tex", "wash pixels", "flicker held");
@@ -577,7 +576,8 @@ int main(int argc, char** argv) {
                          prev_light = pipeline::change_guides(*layer, prev_passes.cview());
       const Image<uint8_t> held =
           light.empty() ? Image<uint8_t>{}
-                        : bench::light_held(light, prev_light, passes.cview(), kLightTolerance);
+                        : bench::light_held(light, prev_light, passes.cview(), kLightTolerance,
+                                            layer->synth.patch_size - 1);
       // Drift: the last quarter of the frames (at least one), where a chain has had time to.
       const bool drift_frame = 4 * (last - f) < last - first + 1;
       for (Variant& v : variants)

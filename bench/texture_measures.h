@@ -97,10 +97,13 @@ inline void add_tone_texture_by_object(std::map<int, ToneTexture>& by_id, const 
 
 // Where the light on the surface held between t-1 and t: each channel of the layer's guides
 // other than the normals (`current`, `previous`: pipeline::change_guides()) differs by at most
-// `tolerance` from its value at the pixel of t-1 the motion vectors point to. The flicker there
-// is the chain's own; elsewhere a moving light or shadow changes what the painting gives.
+// `tolerance` from its value at the pixel of t-1 the motion vectors point to, at the pixel and at
+// every pixel within `reach` of it (a square cut by the image's border): a pixel's value comes
+// from the patches over it, each matched on its guides, so a change of light reaches
+// patch_size - 1 pixels further. The flicker there is the chain's own; elsewhere a moving light,
+// shadow or silhouette changes what the painting gives.
 inline Image<uint8_t> light_held(const Image<float>& current, const Image<float>& previous,
-                                 ImageView<const float> passes, float tolerance) {
+                                 ImageView<const float> passes, float tolerance, int reach = 0) {
   const int w = current.width(), h = current.height();
   Image<uint8_t> out(w, h, 1);
   for (int y = 0; y < h; ++y)
@@ -114,7 +117,25 @@ inline Image<uint8_t> light_held(const Image<float>& current, const Image<float>
         held = std::abs(current(x, y, c) - previous(sx, sy, c)) <= tolerance;
       out(x, y) = held;
     }
-  return out;
+  if (reach <= 0) return out;
+  // The minimum over the square, rows then columns. A pixel whose motion leaves the image
+  // counts as not held for its neighbours too.
+  Image<uint8_t> rows(w, h, 1), eroded(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      uint8_t m = 1;
+      for (int xx = std::max(0, x - reach); xx <= std::min(w - 1, x + reach) && m; ++xx)
+        m = out(xx, y);
+      rows(x, y) = m;
+    }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      uint8_t m = 1;
+      for (int yy = std::max(0, y - reach); yy <= std::min(h - 1, y + reach) && m; ++yy)
+        m = rows(x, yy);
+      eroded(x, y) = m;
+    }
+  return eroded;
 }
 
 // Frames since each pixel's surface was last hidden (0: hidden at t-1), carried along the motion

@@ -163,7 +163,7 @@ LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passe
     for (int y = 0; y < mask.height() && !any; ++y)
       for (int x = 0; x < mask.width() && !any; ++x) any = mask(x, y) > 0.5f;
     if (!any)  // nothing to synthesize: transparent, and no field
-      return {Image<float>(passes.width, passes.height, n + 1), {}, {}};
+      return {Image<float>(passes.width, passes.height, n + 1), {}, {}, {}};
   }
   std::vector<Image<float>> targets, pass_maps;
   targets.reserve(l.guides.size());  // views point into them: no reallocation
