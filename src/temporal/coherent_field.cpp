@@ -113,7 +113,8 @@ Image<int32_t> coherent_field(ImageView<const int32_t> field, int radius) {
   std::vector<int64_t> keys(std::size_t(w) * std::size_t(h));
   parallel_rows(h, 64, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) keys[std::size_t(y) * std::size_t(w) + std::size_t(x)] = offset_key(field, x, y);
+      for (int x = 0; x < w; ++x)
+        keys[std::size_t(y) * std::size_t(w) + std::size_t(x)] = offset_key(field, x, y);
   });
   const int r = radius, side = 2 * r + 1;
   const auto key_at = [&](int x, int y) {
