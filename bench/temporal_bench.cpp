@@ -31,7 +31,6 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -42,6 +41,7 @@
 #include "core/parallel.h"
 #include "core/performance.h"
 #include "io/image_io.h"
+#include "judge_run.h"
 #include "memory_store.h"
 #include "pipeline/flicker.h"
 #include "pipeline/frames.h"
@@ -168,40 +168,6 @@ void write_png(const std::string& path, const Image<float>& img) {
   io::write_image(path, img.cview(), w);
 }
 
-// The judge's view of a guide pass: normals mapped from [-1, 1] to [0, 1], others as they are.
-Image<float> judge_guide(const Image<float>& pass, const std::string& name) {
-  Image<float> out = pass.clone();
-  if (name == "normal")
-    for (int y = 0; y < out.height(); ++y)
-      for (int x = 0; x < out.width(); ++x)
-        for (int c = 0; c < out.channels(); ++c) out(x, y, c) = 0.5f * (out(x, y, c) + 1.0f);
-  return out;
-}
-
-// The judge's figures this bench reports: `style` (is B' made of exemplar texture?) and
-// `coverage` (how much of the exemplar it uses): a temporal chain that washes out to blank
-// paper scores a low style energy, and only its coverage shows it.
-struct JudgeFigures {
-  double style = 0.0, coverage = 0.0;
-};
-
-double json_number(const std::string& out, const std::string& key) {
-  std::smatch m;
-  if (!std::regex_search(out, m, std::regex("\"" + key + "\"\\s*:\\s*([0-9.eE+-]+)")))
-    throw std::runtime_error("no " + key + " in the judge's output: " + out);
-  return std::stod(m[1]);
-}
-
-JudgeFigures run_judge(const std::string& cmd) {
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) throw std::runtime_error("cannot run " + cmd);
-  std::string out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) out += buf;
-  if (pclose(p) != 0) throw std::runtime_error("judge failed: " + cmd + "\n" + out);
-  return {json_number(out, "style"), json_number(out, "coverage")};
-}
-
 // The layer's value over white outside its mask: what the judge and --save see.
 Image<float> on_white(const Image<float>& v, int value_channels) {
   Image<float> out(v.width(), v.height(), value_channels);
@@ -221,6 +187,7 @@ struct Variant {
   double seconds = 0.0;
   pipeline::SequenceFlicker flicker;
   pipeline::SequenceFlicker held_flicker;  // where the light held (bench::light_held)
+  pipeline::SequenceFlicker stuck;  // t-1 carried in whole pixels (bench::carried_whole_pixels)
   pipeline::GhostStats ghost;
   double style_sum = 0.0, coverage_sum = 0.0;
   double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
@@ -431,7 +398,7 @@ std::string judge_setup(const pipeline::Shot& shot, const pipeline::Layer& layer
                                        : pipeline::extract(ex.painting.cview(), 0, 3));
   for (const pipeline::GuideSpec& g : layer.guides)
     write_png(fmt::format("{}/source_{}.png", opt.judge_dir, g.pass),
-              judge_guide(pipeline::extract_pass(ex.passes.cview(), g.pass), g.pass));
+              bench::judge_guide(pipeline::extract_pass(ex.passes.cview(), g.pass), g.pass));
   return fmt::format("'{}' -style '{}'", opt.judge, style);
 }
 
@@ -441,7 +408,7 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
   std::string guides;
   for (const pipeline::GuideSpec& g : layer.guides) {
     const std::string tgt = fmt::format("{}/target_{}_{:04d}.png", opt.judge_dir, g.pass, f);
-    write_png(tgt, judge_guide(pipeline::extract_pass(passes.cview(), g.pass), g.pass));
+    write_png(tgt, bench::judge_guide(pipeline::extract_pass(passes.cview(), g.pass), g.pass));
     guides += fmt::format(" -guide '{}/source_{}.png' '{}' -weight {}", opt.judge_dir, g.pass, tgt,
                           g.weight);
   }
@@ -449,7 +416,8 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
   for (Variant& v : variants) {
     const std::string path = fmt::format("{}/{}_{:04d}.png", opt.judge_dir, v.name, f);
     write_png(path, on_white(v.store.read_layer(layer, f), n));
-    const JudgeFigures j = run_judge(fixed + guides + fmt::format(" -output-to-judge '{}'", path));
+    const bench::JudgeFigures j =
+        bench::run_judge(fixed + guides + fmt::format(" -output-to-judge '{}'", path));
     std::fprintf(stderr, "temporal_bench: judge frame %d %s style %.6f coverage %.4f\n", f,
                  v.name.c_str(), j.style, j.coverage);
     v.style_sum += j.style;
@@ -457,8 +425,8 @@ void judge_frame(const std::string& fixed, const pipeline::Layer& layer, const I
   }
 }
 
-// Flicker of frame f of variant v, its ghosts against the reference variant (frame by frame,
-// when it is the first one) and, with --save, the frame as a PNG.
+// Flicker of frame f of variant v (frame by frame: also of its t-1 carried in whole pixels), its
+// ghosts against the reference variant (frame by frame, when first) and, with --save, the PNG.
 void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& layer,
                    const Image<float>& passes, const Image<float>& prev_passes, int f,
                    bool drift_frame, const Image<uint8_t>& disoccluded, const Image<uint8_t>& held,
@@ -468,6 +436,10 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
   const int mask_channel = cur.channels() > n ? n : -1;
   v.flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                         prev_passes.cview(), mask_channel));
+  if (!v.layer.temporal.enabled)
+    v.stuck.add(pipeline::frame_flicker(bench::carried_whole_pixels(prev, passes.cview()).cview(),
+                                        prev.cview(), passes.cview(), prev_passes.cview(),
+                                        mask_channel));
   if (!held.empty())
     v.held_flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                                prev_passes.cview(), mask_channel, nullptr, &held));
@@ -523,6 +495,9 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
                 ghosted ? fmt::format("{:.5f}", v.ghost.visible_diff()).c_str() : "-",
                 drift_text.c_str());
   }
+  if (ref && base.stuck.all.pixels)
+    std::printf("stuck (frame by frame's t-1 carried to t in whole pixels) %8.2fx\n",
+                base.stuck.all.mean() / base.flicker.all.mean());
 }
 
 // Against frame by frame, same pixels: tone drift and texture kept inside the mask over the last

@@ -95,6 +95,24 @@ inline void add_tone_texture_by_object(std::map<int, ToneTexture>& by_id, const 
     }
 }
 
+// Frame t-1 carried to t along the motion vectors in whole pixels (each pixel takes the pixel of
+// t-1 its motion points to, rounded; clamped to the image): a picture stuck to its surfaces as a
+// chain that carries whole pixels would at best keep it. Its flicker against t-1 is the least such
+// a chain can score with that picture's texture (the measure samples t-1 between pixels).
+inline Image<float> carried_whole_pixels(const Image<float>& previous,
+                                         ImageView<const float> passes) {
+  const int w = previous.width(), h = previous.height();
+  Image<float> out(w, h, previous.channels());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* p = passes.at(x, y);
+      const int sx = std::clamp(int(std::lround(x + p[render::kMotion])), 0, w - 1),
+                sy = std::clamp(int(std::lround(y + p[render::kMotion + 1])), 0, h - 1);
+      for (int c = 0; c < previous.channels(); ++c) out(x, y, c) = previous(sx, sy, c);
+    }
+  return out;
+}
+
 // Where the light on the surface held between t-1 and t: each channel of the layer's guides
 // other than the normals (`current`, `previous`: pipeline::change_guides()) differs by at most
 // `tolerance` from its value at the pixel of t-1 the motion vectors point to, at the pixel and at
@@ -118,24 +136,22 @@ inline Image<uint8_t> light_held(const Image<float>& current, const Image<float>
       out(x, y) = held;
     }
   if (reach <= 0) return out;
-  // The minimum over the square, rows then columns. A pixel whose motion leaves the image
-  // counts as not held for its neighbours too.
-  Image<uint8_t> rows(w, h, 1), eroded(w, h, 1);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      uint8_t m = 1;
-      for (int xx = std::max(0, x - reach); xx <= std::min(w - 1, x + reach) && m; ++xx)
-        m = out(xx, y);
-      rows(x, y) = m;
-    }
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      uint8_t m = 1;
-      for (int yy = std::max(0, y - reach); yy <= std::min(h - 1, y + reach) && m; ++yy)
-        m = rows(x, yy);
-      eroded(x, y) = m;
-    }
-  return eroded;
+  // The minimum over the square, along rows then along columns. A pixel whose motion leaves the
+  // image counts as not held for its neighbours too.
+  const auto min_along = [&](const Image<uint8_t>& in, int dx, int dy) {
+    Image<uint8_t> m(w, h, 1);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 1;
+        for (int k = -reach; k <= reach && v; ++k) {
+          const int xx = x + k * dx, yy = y + k * dy;
+          if (xx >= 0 && yy >= 0 && xx < w && yy < h) v = in(xx, yy);
+        }
+        m(x, y) = v;
+      }
+    return m;
+  };
+  return min_along(min_along(out, 1, 0), 0, 1);
 }
 
 // Frames since each pixel's surface was last hidden (0: hidden at t-1), carried along the motion
