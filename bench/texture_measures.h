@@ -95,6 +95,16 @@ inline void add_tone_texture_by_object(std::map<int, ToneTexture>& by_id, const 
     }
 }
 
+// The pixel of t-1 that pixel (x, y) of t comes from: the end of its motion vector, rounded (it
+// may lie outside the image).
+struct Pixel {
+  int x = 0, y = 0;
+};
+inline Pixel motion_source(ImageView<const float> passes, int x, int y) {
+  const float* p = passes.at(x, y);
+  return {int(std::lround(x + p[render::kMotion])), int(std::lround(y + p[render::kMotion + 1]))};
+}
+
 // Frame t-1 carried to t along the motion vectors in whole pixels (each pixel takes the pixel of
 // t-1 its motion points to, rounded; clamped to the image): a picture stuck to its surfaces as a
 // chain that carries whole pixels would at best keep it. Its flicker against t-1 is the least such
@@ -105,9 +115,8 @@ inline Image<float> carried_whole_pixels(const Image<float>& previous,
   Image<float> out(w, h, previous.channels());
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const float* p = passes.at(x, y);
-      const int sx = std::clamp(int(std::lround(x + p[render::kMotion])), 0, w - 1),
-                sy = std::clamp(int(std::lround(y + p[render::kMotion + 1])), 0, h - 1);
+      const Pixel q = motion_source(passes, x, y);
+      const int sx = std::clamp(q.x, 0, w - 1), sy = std::clamp(q.y, 0, h - 1);
       for (int c = 0; c < previous.channels(); ++c) out(x, y, c) = previous(sx, sy, c);
     }
   return out;
@@ -126,9 +135,7 @@ inline Image<uint8_t> light_held(const Image<float>& current, const Image<float>
   Image<uint8_t> out(w, h, 1);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const float* p = passes.at(x, y);
-      const int sx = int(std::lround(x + p[render::kMotion])),
-                sy = int(std::lround(y + p[render::kMotion + 1]));
+      const auto [sx, sy] = motion_source(passes, x, y);
       if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
       bool held = true;
       for (int c = 0; c < current.channels() && held; ++c)
@@ -169,8 +176,7 @@ inline void update_disocclusion_age(Image<uint8_t>& age, ImageView<const float> 
   Image<uint8_t> next(w, h, 1);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const int sx = int(std::lround(x + motion(x, y, 0))),
-                sy = int(std::lround(y + motion(x, y, 1)));
+      const auto [sx, sy] = motion_source(passes, x, y);
       const bool inside = sx >= 0 && sy >= 0 && sx < w && sy < h;
       const int before = age.empty() || !inside ? 255 : age(sx, sy);
       next(x, y) = visible(x, y) ? uint8_t(std::min(255, before + 1)) : 0;
