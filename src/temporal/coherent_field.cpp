@@ -130,6 +130,13 @@ Image<int32_t> coherent_field(ImageView<const int32_t> field, int radius) {
       const auto remove_column = [&](int c) {
         for (int yy = y0; yy <= y1; ++yy) window.remove(key_at(c, yy));
       };
+      // When several offsets have the most pixels: the one met first in row order.
+      const auto first_with = [&](int count, int x0, int x1) {
+        for (int yy = y0; yy <= y1; ++yy)
+          for (int xx = x0; xx <= x1; ++xx)
+            if (const int64_t k = key_at(xx, yy); k != kNone && window.count(k) == count) return k;
+        return kNone;  // not reached: `count` is some offset's
+      };
       window.clear();
       for (int c = 0; c <= std::min(w - 1, r); ++c) add_column(c);
       for (int x = 0; x < w; ++x) {
@@ -153,17 +160,7 @@ Image<int32_t> coherent_field(ImageView<const int32_t> field, int radius) {
             ++tied;
           }
         }
-        if (tied > 1) {  // several offsets have the most: the one met first in row order
-          const int x0 = std::max(0, x - r), x1 = std::min(w - 1, x + r);
-          for (int yy = y0, found = 0; yy <= y1 && !found; ++yy)
-            for (int xx = x0; xx <= x1; ++xx) {
-              const int64_t k = key_at(xx, yy);
-              if (k != kNone && window.count(k) == best) {
-                mode = k, found = 1;
-                break;
-              }
-            }
-        }
+        if (tied > 1) mode = first_with(best, std::max(0, x - r), std::min(w - 1, x + r));
         if (mode == own) continue;
         out(x, y, 0) = x + int32_t(uint32_t(uint64_t(mode) >> 32));
         out(x, y, 1) = y + int32_t(uint32_t(uint64_t(mode)));
