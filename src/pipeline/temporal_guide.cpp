@@ -229,8 +229,9 @@ std::vector<KeptField> advection_fields(const Shot& shot, ImageView<const float>
 
 // The main transfer's schedule with a warm start, unless the layer sets its own counts (which
 // then hold at that one level as at every other): the finest level alone, one search-vote
-// iteration of two PatchMatch sweeps within 32 pixels — what the whole pyramid's finest level
-// runs at a temporal frame. Measured on the example (docs/design/warm-start.md): a random search
+// iteration of the layer's PatchMatch sweeps (two; one for the base kind, whose snap already
+// made its field coherent) within 32 pixels — what the whole pyramid's finest level runs at a
+// temporal frame. Measured on the example (docs/design/warm-start.md): a random search
 // over the whole exemplar, or two search-vote iterations, evaluate more candidates and lowered the
 // judge's style energy by 0.7-2.2 % only (frames 4 and 12).
 void warm_schedule(const SynthSpec& s, const TemporalSpec& t, synth::Params& p) {

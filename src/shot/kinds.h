@@ -121,6 +121,9 @@ struct KindDefaults {
   // the frame's size against the painting's (TemporalSpec::coherence_radius -1; not a shot-file
   // key).
   bool temporal_coherence = false;
+  // PatchMatch sweeps in the warm start's search-vote iteration (TemporalSpec::
+  // warm_patch_match_iters; not a shot-file key).
+  int temporal_warm_sweeps = 2;
 };
 
 KindDefaults kind_defaults(pipeline::LayerKind kind);

@@ -222,6 +222,7 @@ void parse_layer(const Reader& r, const pipeline::Shot& shot, pipeline::Layer& l
   l.temporal.ink_confident = d.temporal_ink_confident;
   l.temporal.ink_objects = l.temporal.ink_blend = d.temporal_ink_objects;
   l.temporal.coherence_radius = d.temporal_coherence ? -1 : 0;
+  l.temporal.warm_patch_match_iters = d.temporal_warm_sweeps;
   l.temporal.warm_start = r.boolean("temporal_warm_start", l.temporal.warm_start);
   l.temporal.keep_every_field =
       r.choice("temporal_fields", l.temporal.keep_every_field, kKeptFields);

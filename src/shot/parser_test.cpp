@@ -88,6 +88,10 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   // The shadow's pin is per object, its references blended between refreshes; not the outline's.
   EXPECT_TRUE(s.layers[2].temporal.ink_objects && s.layers[2].temporal.ink_blend);
   EXPECT_FALSE(s.layers[1].temporal.ink_objects || s.layers[1].temporal.ink_blend);
+  // The base's warm start sweeps once after its snap, the other kinds twice.
+  EXPECT_EQ(s.layers[0].temporal.coherence_radius, -1);
+  EXPECT_EQ(s.layers[0].temporal.warm_patch_match_iters, 1);
+  for (int i : {1, 2}) EXPECT_EQ(s.layers[i].temporal.warm_patch_match_iters, 2);
   // Hatching: the town's second style, its ink pinned as the shadow's.
   const pipeline::Layer h =
       parse_shot(minimal("[layers.h]\nkind = \"hatching\"\nexemplar = \"sphere\"\n"),
@@ -101,6 +105,7 @@ TEST(ShotFile, KindsSetTheirDefaults) {
   EXPECT_EQ(h.temporal.ink_refresh, 8);
   EXPECT_FLOAT_EQ(h.temporal.ink_confident, 1.0f);
   EXPECT_FALSE(h.temporal.ink_objects);
+  EXPECT_EQ(h.temporal.warm_patch_match_iters, 2);
   EXPECT_FLOAT_EQ(parse_shot(minimal("[layers.dark]\nkind = \"shadow\"\nexemplar = \"sphere\"\n"
                                      "uniformity = 2000\n"),
                              "/tmp/shot.toml")
