@@ -74,7 +74,8 @@ AdvectionField advection_field(const AdvectionInputs& in, const synth::Params& p
 // matched on the position guide alone (style weight 0). The schedule is the advection's own:
 // the field starts at the identity (the two frames are nearly aligned) and one search-vote
 // iteration of two PatchMatch sweeps at full resolution, random search within
-// `search_radius`, refines it. Measured on the example against the main transfer's multiscale
+// `search_radius`, refines it; with surfaces it starts where their motion vectors point instead,
+// and one sweep refines it. Measured on the example against the main transfer's multiscale
 // schedule with a style weight of 1 against the guide's 1000: less flicker and a third of the
 // advection's time (docs/design/advection.md). The field covers the whole frame; with a mask, B'adv
 // is voted inside it (dilated by the patch radius, as the synthesizer does) from the patches

@@ -75,6 +75,36 @@ TEST(Advection, FindsMotionWithinTheSearchRadius) {
   EXPECT_LT(s / n, 0.03);
 }
 
+// With the surfaces' motion vectors the field starts where they point: a motion five times the
+// search radius is found at once, where a start at the identity could not reach it.
+TEST(Advection, StartsWhereTheMotionVectorsPoint) {
+  const int w = 128, h = 64, shift = 40;
+  const Image<float> g_prev = position_guide(w, h, 0.0f), g_cur = position_guide(w, h, shift);
+  Image<float> rest_prev(w, h, 4), rest_cur(w, h, 4), motion(w, h, 2);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c)
+        rest_prev(x, y, c) = g_prev(x, y, c), rest_cur(x, y, c) = g_cur(x, y, c);
+      rest_prev(x, y, 3) = rest_cur(x, y, 3) = 1.0f;  // one object
+      motion(x, y, 0) = float(shift);
+    }
+  motion(0, 0, 0) = NAN;  // a damaged vector starts at the pixel itself
+  const Image<float> prev = stripes(w, h, 0.0f);
+  AdvectionInputs in;
+  in.previous_stylized = prev.cview();
+  in.previous_guide = g_prev.cview();
+  in.current_guide = g_cur.cview();
+  in.surfaces = Surfaces{rest_prev.cview(), rest_cur.cview(), motion.cview()};
+  synth::Params p;
+  p.patch_size = 5;
+  const AdvectionField f = advection_field(in, p);
+  int found = 0, n = 0;
+  for (int y = 2; y < h - 2; ++y)
+    for (int x = 2; x + shift < w - 2; ++x, ++n)
+      found += f.nnf(x, y, 0) == x + shift && f.nnf(x, y, 1) == y;
+  EXPECT_GT(found, 0.99 * n) << found << " of " << n;
+}
+
 // Outside its mask the previous frame had nothing; the advection reads the empty value there.
 TEST(Advection, MaskedPreviousFrameUsesTheEmptyValue) {
   const int w = 48, h = 32;
