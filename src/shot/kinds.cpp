@@ -16,8 +16,8 @@ KindDefaults kind_defaults(pipeline::LayerKind kind) {
       d.temporal_coherence = true;
       // After the snap one sweep holds the picture: on the four shots of
       // docs/design/long-shots.md flicker within 0.02x of two sweeps' and tone nearer frame by
-      // frame's, for a fifth less time (docs/design/warm-start.md). The other kinds lost texture
-      // or flickered more with one (the hatching 0.805x -> 0.753x on the town).
+      // frame's on three of them, for a fifth less time (docs/design/warm-start.md). The other
+      // kinds lost texture or flickered more with one (the hatching 0.805x -> 0.753x on the town).
       d.temporal_warm_sweeps = 1;
       break;
     case pipeline::LayerKind::kShadow:

@@ -16,8 +16,9 @@ namespace {
 synth::Params field_params(const synth::Params& params, int search_radius, int width, int height) {
   synth::Params p = params;
   p.uniformity = 0.0f;
-  // Consecutive frames are nearly aligned: the field starts at the identity and is refined at
-  // full resolution only, within a radius that covers a frame's motion.
+  // Consecutive frames are nearly aligned: the field starts at the identity (or, with motion
+  // vectors, where they point: advection_field() then runs one sweep) and is refined at full
+  // resolution only, within a radius that covers a frame's motion.
   p.init = synth::FieldInit::kIdentity;
   p.pyramid_levels = 1;
   p.search_vote_iters = 1;
@@ -53,10 +54,9 @@ Image<int32_t> motion_start(ImageView<const float> motion, int patch_size) {
       for (int x = 0; x < w; ++x) {
         const float* m = motion.at(x, y);
         const bool finite = std::isfinite(m[0]) && std::isfinite(m[1]);
-        const float sx = finite ? std::clamp(x + m[0], -1.0f, float(w)) : float(x);
-        const float sy = finite ? std::clamp(y + m[1], -1.0f, float(h)) : float(y);
-        start(x, y, 0) = std::clamp(int(std::lround(sx)), r, w - 1 - r);
-        start(x, y, 1) = std::clamp(int(std::lround(sy)), r, h - 1 - r);
+        const float sx = finite ? x + m[0] : float(x), sy = finite ? y + m[1] : float(y);
+        start(x, y, 0) = int(std::lround(std::clamp(sx, float(r), float(w - 1 - r))));
+        start(x, y, 1) = int(std::lround(std::clamp(sy, float(r), float(h - 1 - r))));
       }
   });
   return start;

@@ -88,7 +88,7 @@ TEST(Advection, StartsWhereTheMotionVectorsPoint) {
       rest_prev(x, y, 3) = rest_cur(x, y, 3) = 1.0f;  // one object
       motion(x, y, 0) = float(shift);
     }
-  motion(0, 0, 0) = NAN;  // a damaged vector starts at the pixel itself
+  motion(0, 0, 0) = NAN;  // a damaged vector (outside the pixels counted) must not break the field
   const Image<float> prev = stripes(w, h, 0.0f);
   AdvectionInputs in;
   in.previous_stylized = prev.cview();
