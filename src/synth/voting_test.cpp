@@ -127,5 +127,31 @@ TEST(Voting, EqualsThePerPixelVote) {
   expect_votes_equal_per_pixel_vote<float>(1.0, 1.0);
 }
 
+// The dilation against the square window it stands for, looked up pixel by pixel: sparse and
+// dense masks, an empty one, radii from 0 to more than the image.
+TEST(Voting, DilateMaskSetsEveryPixelWithASetPixelInItsSquare) {
+  CounterRng rng(11);
+  for (const int density : {0, 1, 30, 400}) {
+    const int w = 97, h = 61;
+    Image<uint8_t> inside(w, h, 1);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        inside(x, y) = density > 0 && rng.uniform(1000) < uint32_t(density) ? 1 : 0;
+    if (density == 1) inside(0, 0) = inside(w - 1, h - 1) = 1;  // at the corners too
+    for (const int r : {0, 1, 2, 7, 40, 200}) {
+      const Image<uint8_t> out = dilate_mask(inside, r);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          uint8_t want = 0;
+          for (int v = std::max(0, y - r); v <= std::min(h - 1, y + r); ++v)
+            for (int u = std::max(0, x - r); u <= std::min(w - 1, x + r); ++u)
+              want |= inside(u, v) ? 1 : 0;
+          ASSERT_EQ(out(x, y), want)
+              << "density " << density << " radius " << r << " at " << x << "," << y;
+        }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace emaki::synth
