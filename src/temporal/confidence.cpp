@@ -6,6 +6,7 @@
 
 #include "core/check.h"
 #include "core/parallel.h"
+#include "synth/voting.h"
 
 namespace emaki::temporal {
 
@@ -133,9 +134,12 @@ Image<float> foreign_share(const Image<int32_t>& nnf, const Image<uint8_t>& acti
   const bool all = active.empty();
   CHECK(all || (active.width() == w && active.height() == h));
   Image<float> out(w, h, 1);
+  // A pixel whose window holds no active patch centre has no vote: 0, without looking.
+  const Image<uint8_t> voted = all ? Image<uint8_t>() : synth::dilate_mask(active, r);
   parallel_rows(h, 32, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < w; ++x) {
+        if (!all && !voted(x, y)) continue;
         const int ux0 = std::max(0, x - r), ux1 = std::min(w - 1, x + r);
         const int uy0 = std::max(0, y - r), uy1 = std::min(h - 1, y + r);
         // The pixel's own object, looked up once for its votes.
