@@ -364,26 +364,62 @@ void occupancy_window_sums(const PatchMatchLevel& L, int p, std::vector<int32_t>
         const int32_t* m = L.nnf->at(x, y);
         sums[std::size_t(m[1]) * L.sw + m[0]] += 1;
       }
+  // The triangle (p - |d|, |d| < p) is a box of p taps convolved with itself: a running box
+  // sum over the positions up to r beyond the image too (pixels outside count 0), then a running
+  // box sum of that. Integer sums: the same as the triangle's taps added one by one.
+  const int r = p / 2;
+  // Rows: once[i + r] = the box at i in [-r, n + r); out[i] = the box of `once` at i in [0, n).
   parallel_rows(L.sh, 64, [&](int y0, int y1) {
+    const int n = L.sw;
+    std::vector<int32_t> once(std::size_t(n) + 2 * std::size_t(r));
     for (int y = y0; y < y1; ++y) {
-      const int32_t* count = sums.data() + std::size_t(y) * L.sw;
-      int32_t* out = scratch.data() + std::size_t(y) * L.sw;
-      for (int x = 0; x < L.sw; ++x) {
-        int32_t s = 0;
-        for (int d = std::max(-(p - 1), -x); d <= std::min(p - 1, L.sw - 1 - x); ++d)
-          s += (p - std::abs(d)) * count[x + d];
-        out[x] = s;
+      const int32_t* in = sums.data() + std::size_t(y) * n;
+      int32_t* out = scratch.data() + std::size_t(y) * n;
+      int32_t s = 0;  // the box at i, less in[i + r]
+      for (int i = -r; i < n + r; ++i) {
+        if (i + r < n) s += in[i + r];
+        once[std::size_t(i + r)] = s;
+        if (i - r >= 0) s -= in[i - r];
+      }
+      s = 0;
+      for (int k = 0; k < 2 * r; ++k) s += once[std::size_t(k)];
+      for (int i = 0; i < n; ++i) {
+        s += once[std::size_t(i + 2 * r)];
+        out[i] = s;
+        s -= once[std::size_t(i)];
       }
     }
   });
-  parallel_rows(L.sh, 64, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < L.sw; ++x) {
-        int32_t s = 0;
-        for (int d = std::max(-(p - 1), -y); d <= std::min(p - 1, L.sh - 1 - y); ++d)
-          s += (p - std::abs(d)) * scratch[std::size_t(y + d) * L.sw + x];
-        sums[std::size_t(y) * L.sw + x] = s;
+  // Columns, the same row by row over a block of columns at a time.
+  constexpr int kBlock = 256;
+  const int blocks = (L.sw + kBlock - 1) / kBlock;
+  parallel_for(blocks, 1, [&](int64_t b0, int64_t b1) {
+    const int n = L.sh;
+    std::vector<int32_t> once((std::size_t(n) + 2 * std::size_t(r)) * kBlock), s(kBlock);
+    for (int64_t b = b0; b < b1; ++b) {
+      const int x0 = int(b) * kBlock, nb = std::min(kBlock, L.sw - x0);
+      const auto in = [&](int y) { return scratch.data() + std::size_t(y) * L.sw + x0; };
+      const auto row = [&](int i) { return once.data() + std::size_t(i + r) * kBlock; };
+      std::fill(s.begin(), s.end(), 0);
+      for (int i = -r; i < n + r; ++i) {
+        if (i + r < n)
+          for (int k = 0; k < nb; ++k) s[k] += in(i + r)[k];
+        std::copy(s.begin(), s.begin() + nb, row(i));
+        if (i - r >= 0)
+          for (int k = 0; k < nb; ++k) s[k] -= in(i - r)[k];
       }
+      std::fill(s.begin(), s.end(), 0);
+      for (int i = -r; i < r; ++i)
+        for (int k = 0; k < nb; ++k) s[k] += row(i)[k];
+      for (int y = 0; y < n; ++y) {
+        int32_t* out = sums.data() + std::size_t(y) * L.sw + x0;
+        for (int k = 0; k < nb; ++k) {
+          s[k] += row(y + r)[k];
+          out[k] = s[k];
+          s[k] -= row(y - r)[k];
+        }
+      }
+    }
   });
 }
 
