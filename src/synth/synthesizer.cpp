@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -83,11 +84,37 @@ FeatureLayout make_layout(const Inputs& in, const Params& p) {
 void quantize_plane(const Plane& plane, const FeatureLayout& L, int c0, Image<int16_t>& feat,
                     int off) {
   const int nc = plane_channels(plane), w = plane_width(plane);
+  const ChannelMap* map = L.map.data() + c0;
+  const std::ptrdiff_t step = feat.channels();
+  // The channel count fixed at compile time for the common planes, so the maps stay in registers.
+  const auto rows = [&]<int NC>(std::integral_constant<int, NC>) {
+    parallel_rows(plane_height(plane), 32, [&](int y0, int y1) {
+      ChannelMap m[NC];
+      std::copy(map, map + NC, m);
+      for_each_row(plane, y0, y1, [&](int y, const float* row) {
+        int16_t* f = feat.at(off, y + off) + c0;
+        for (int x = 0; x < w; ++x, f += step, row += NC)
+          for (int c = 0; c < NC; ++c) f[c] = m[c].quantize(row[c]);
+      });
+    });
+  };
+  switch (nc) {
+    case 1:
+      return rows(std::integral_constant<int, 1>{});
+    case 2:
+      return rows(std::integral_constant<int, 2>{});
+    case 3:
+      return rows(std::integral_constant<int, 3>{});
+    case 4:
+      return rows(std::integral_constant<int, 4>{});
+    default:
+      break;
+  }
   parallel_rows(plane_height(plane), 32, [&](int y0, int y1) {
     for_each_row(plane, y0, y1, [&](int y, const float* row) {
       for (int x = 0; x < w; ++x) {
         int16_t* f = feat.at(x + off, y + off);
-        for (int c = 0; c < nc; ++c) f[c0 + c] = L.map[c0 + c].quantize(row[x * nc + c]);
+        for (int c = 0; c < nc; ++c) f[c0 + c] = map[c].quantize(row[x * nc + c]);
       }
     });
   });
