@@ -43,28 +43,60 @@ std::vector<float> gaussian_kernel(float sigma) {
   return k;
 }
 
-// One separable pass along x (dx = 1) or y: value x weight and weight, both convolved.
+// One separable pass along x or y: value x weight and weight, both convolved. Each pixel's taps
+// are added in kernel order in doubles, the columns' a whole row of pixels at a time.
 void blur_pass(const Image<float>& in, const Image<float>& in_w, Image<float>& out,
                Image<float>& out_w, const std::vector<float>& k, bool along_x) {
   const int w = in.width(), h = in.height(), n = in.channels(), r = int(k.size()) / 2;
   out.reset(w, h, n);
   out_w.reset(w, h, 1);
   parallel_rows(h, 16, [&](int y0, int y1) {
-    std::vector<double> acc(n);
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        std::fill(acc.begin(), acc.end(), 0.0);
-        double sw = 0.0;
-        for (int i = -r; i <= r; ++i) {
-          const int u = std::clamp(along_x ? x + i : x, 0, w - 1);
-          const int v = std::clamp(along_x ? y : y + i, 0, h - 1);
-          const double wt = double(k[i + r]) * in_w(u, v);
-          sw += wt;
-          for (int c = 0; c < n; ++c) acc[c] += wt * in(u, v, c);
+    std::vector<double> acc(std::size_t(w) * n), sum(static_cast<std::size_t>(w));
+    for (int y = y0; y < y1; ++y) {
+      std::fill(acc.begin(), acc.end(), 0.0);
+      std::fill(sum.begin(), sum.end(), 0.0);
+      if (along_x) {
+        const float* row = in.row(y);
+        const float* row_w = in_w.row(y);
+        for (int x = 0; x < w; ++x) {
+          double* a = acc.data() + std::size_t(x) * n;
+          double& sw = sum[std::size_t(x)];
+          for (int i = -r; i <= r; ++i) {
+            const int u = std::clamp(x + i, 0, w - 1);
+            const double wt = double(k[i + r]) * row_w[u];
+            sw += wt;
+            for (int c = 0; c < n; ++c) a[c] += wt * row[std::size_t(u) * n + c];
+          }
         }
-        out_w(x, y) = float(sw);
-        for (int c = 0; c < n; ++c) out(x, y, c) = sw > 0.0 ? float(acc[c] / sw) : in(x, y, c);
+      } else {
+        for (int i = -r; i <= r; ++i) {
+          const int v = std::clamp(y + i, 0, h - 1);
+          const float* row = in.row(v);
+          const float* row_w = in_w.row(v);
+          const double kw = double(k[i + r]);
+          if (n == 1) {
+            for (int x = 0; x < w; ++x) {
+              const double wt = kw * row_w[x];
+              sum[std::size_t(x)] += wt;
+              acc[std::size_t(x)] += wt * row[x];
+            }
+          } else {
+            for (int x = 0; x < w; ++x) {
+              const double wt = kw * row_w[x];
+              sum[std::size_t(x)] += wt;
+              for (int c = 0; c < n; ++c)
+                acc[std::size_t(x) * n + c] += wt * row[std::size_t(x) * n + c];
+            }
+          }
+        }
       }
+      for (int x = 0; x < w; ++x) {
+        const double sw = sum[std::size_t(x)];
+        out_w(x, y) = float(sw);
+        for (int c = 0; c < n; ++c)
+          out(x, y, c) = sw > 0.0 ? float(acc[std::size_t(x) * n + c] / sw) : in(x, y, c);
+      }
+    }
   });
 }
 

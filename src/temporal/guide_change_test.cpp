@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
 namespace emaki::temporal {
 namespace {
 
@@ -71,6 +76,60 @@ TEST(LowPass, AMaskKeepsWhatLiesOutsideOut) {
   EXPECT_NEAR(inside(15, 4), 0.1f, 1e-5f);
   EXPECT_NEAR(inside(3, 4), 1.0f, 1e-6f);
   EXPECT_GT(everywhere(15, 4), 0.4f);
+}
+
+// The masked low-pass is a normalised convolution: each pass sums value x weight and weight over
+// the kernel's taps (borders clamped) in doubles, tap by tap in kernel order; the column pass
+// weighs each row result by the mask it saw. One and three channels, to the bit.
+TEST(LowPass, IsTheNormalisedConvolutionTapByTap) {
+  for (const int n : {1, 3}) {
+    const int w = 37, h = 23;
+    const float sigma = 3.0f;
+    Image<float> g(w, h, n), mask(w, h, 1);
+    uint32_t state = 12345;
+    const auto next = [&] {
+      return float((state = state * 1664525u + 1013904223u) >> 8) / 16777216.0f;
+    };
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < n; ++c) g(x, y, c) = next();
+        mask(x, y) = next() < 0.7f ? 1.0f : 0.0f;
+      }
+    const Image<float> got = low_pass(g.cview(), sigma, mask.cview());
+    const int r = int(std::ceil(3.0f * sigma));
+    std::vector<float> k(std::size_t(2 * r + 1));
+    for (int i = -r; i <= r; ++i)
+      k[std::size_t(i + r)] = std::exp(-0.5f * float(i * i) / (sigma * sigma));
+    const auto pass = [&](const Image<float>& in, const Image<float>& in_w, Image<float>& out,
+                          Image<float>& out_w, bool along_x) {
+      out.reset(w, h, n);
+      out_w.reset(w, h, 1);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          std::vector<double> acc(std::size_t(n), 0.0);
+          double sw = 0.0;
+          for (int i = -r; i <= r; ++i) {
+            const int u = std::clamp(along_x ? x + i : x, 0, w - 1);
+            const int v = std::clamp(along_x ? y : y + i, 0, h - 1);
+            const double wt = double(k[std::size_t(i + r)]) * in_w(u, v);
+            sw += wt;
+            for (int c = 0; c < n; ++c) acc[std::size_t(c)] += wt * in(u, v, c);
+          }
+          out_w(x, y) = float(sw);
+          for (int c = 0; c < n; ++c)
+            out(x, y, c) = sw > 0.0 ? float(acc[std::size_t(c)] / sw) : in(x, y, c);
+        }
+    };
+    Image<float> rows, rows_w, want, want_w;
+    pass(g, mask, rows, rows_w, true);
+    pass(rows, rows_w, want, want_w, false);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < n; ++c) {
+          const float expect = mask(x, y) > 0.0f ? want(x, y, c) : g(x, y, c);
+          ASSERT_EQ(got(x, y, c), expect) << n << " channels at " << x << "," << y;
+        }
+  }
 }
 
 }  // namespace
