@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <mutex>
+#include <vector>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -24,31 +27,50 @@ int plane_channels(const Plane& p) {
 }
 
 void plane_range(const Plane& p, int c, float& lo, float& hi) {
+  std::vector<float> l, h;
+  plane_ranges(p, l, h);
+  lo = std::min(lo, l[std::size_t(c)]);
+  hi = std::max(hi, h[std::size_t(c)]);
+}
+
+void plane_ranges(const Plane& p, std::vector<float>& lo, std::vector<float>& hi) {
+  const int nc = plane_channels(p), w = plane_width(p);
+  lo.assign(std::size_t(nc), INFINITY);
+  hi.assign(std::size_t(nc), -INFINITY);
   std::mutex m;
-  const float lo0 = lo, hi0 = hi;
   parallel_rows(plane_height(p), 32, [&](int y0, int y1) {
-    float l = lo0, h = hi0;
-    const int nc = plane_channels(p), w = plane_width(p);
+    std::vector<float> l(std::size_t(nc), INFINITY), h(std::size_t(nc), -INFINITY);
     for_each_row(p, y0, y1, [&](int, const float* row) {
-      for (int x = 0; x < w; ++x) {
-        l = std::min(l, row[x * nc + c]);
-        h = std::max(h, row[x * nc + c]);
-      }
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < nc; ++c) {
+          l[std::size_t(c)] = std::min(l[std::size_t(c)], row[x * nc + c]);
+          h[std::size_t(c)] = std::max(h[std::size_t(c)], row[x * nc + c]);
+        }
     });
     std::lock_guard lock(m);
-    lo = std::min(lo, l);
-    hi = std::max(hi, h);
+    for (int c = 0; c < nc; ++c) {
+      lo[std::size_t(c)] = std::min(lo[std::size_t(c)], l[std::size_t(c)]);
+      hi[std::size_t(c)] = std::max(hi[std::size_t(c)], h[std::size_t(c)]);
+    }
   });
 }
 
 void check_finite(const Plane& p, const std::string& name) {
   if (!is_float(p)) return;
   const auto& v = std::get<2>(p);
+  // A value is not finite when its exponent bits are all set; or-ed over a row, branch-free.
   std::atomic<bool> bad{false};
   parallel_rows(v.height, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1 && !bad.load(std::memory_order_relaxed); ++y)
-      for (int i = 0; i < v.width * v.channels; ++i)
-        if (!std::isfinite(v.row(y)[i])) bad.store(true, std::memory_order_relaxed);
+    for (int y = y0; y < y1 && !bad.load(std::memory_order_relaxed); ++y) {
+      const float* row = v.row(y);
+      uint32_t any = 0;
+      for (int i = 0; i < v.width * v.channels; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, row + i, sizeof bits);
+        any |= (bits & 0x7f800000u) == 0x7f800000u ? 1u : 0u;
+      }
+      if (any) bad.store(true, std::memory_order_relaxed);
+    }
   });
   if (!bad) return;
   // Name the first bad pixel in row order, whichever band found one.

@@ -41,29 +41,37 @@ FeatureLayout make_layout(const Inputs& in, const Params& p) {
   L.channels = (n + 7) / 8 * 8;
   std::vector<float> w;
   std::vector<std::pair<float, float>> range;
-  auto add_range = [&](const Plane& a, const Plane* b, int c) {
+  // Each channel's range, [0, 1] unless the values leave it: every plane's channels in one pass.
+  auto add_ranges = [&](const Plane& a, const Plane* b) {
+    const int nc = plane_channels(a);
     if (!is_float(a) && (b == nullptr || !is_float(*b))) {
-      range.push_back({0.0f, 1.0f});
+      range.insert(range.end(), std::size_t(nc), {0.0f, 1.0f});
       return;
     }
-    float lo = 0.0f, hi = 1.0f;  // [0, 1] unless the values leave it
-    float mn = INFINITY, mx = -INFINITY;
-    plane_range(a, c, mn, mx);
-    if (b) plane_range(*b, c, mn, mx);
-    if (mn < 0.0f || mx > 1.0f) lo = mn, hi = std::max(mx, mn + 1e-12f);
-    range.push_back({lo, hi});
+    std::vector<float> mn, mx, b_mn, b_mx;
+    plane_ranges(a, mn, mx);
+    if (b) {
+      plane_ranges(*b, b_mn, b_mx);
+      for (int c = 0; c < nc; ++c) {
+        mn[std::size_t(c)] = std::min(mn[std::size_t(c)], b_mn[std::size_t(c)]);
+        mx[std::size_t(c)] = std::max(mx[std::size_t(c)], b_mx[std::size_t(c)]);
+      }
+    }
+    for (int c = 0; c < nc; ++c) {
+      const float lo = mn[std::size_t(c)], hi = mx[std::size_t(c)];
+      if (lo < 0.0f || hi > 1.0f)
+        range.push_back({lo, std::max(hi, lo + 1e-12f)});
+      else
+        range.push_back({0.0f, 1.0f});
+    }
   };
   const float style_w = p.style_weight < 0.0f ? 1.0f : p.style_weight;
-  for (int c = 0; c < L.style_channels; ++c) {
-    w.push_back(style_w / float(L.style_channels));
-    add_range(in.style, nullptr, c);
-  }
+  for (int c = 0; c < L.style_channels; ++c) w.push_back(style_w / float(L.style_channels));
+  add_ranges(in.style, nullptr);
   for (const auto& g : in.guides) {
     const int nc = plane_channels(g.source);
-    for (int c = 0; c < nc; ++c) {
-      w.push_back(guide_weight(g, in.guides.size()) / float(nc));
-      add_range(g.source, &g.target, c);
-    }
+    for (int c = 0; c < nc; ++c) w.push_back(guide_weight(g, in.guides.size()) / float(nc));
+    add_ranges(g.source, &g.target);
   }
   float w_max = 0.0f;
   for (float x : w) w_max = std::max(w_max, x);

@@ -373,6 +373,27 @@ TEST(Validate, RejectsBadInputsNamingThem) {
   in = f.inputs();
   in.guides[0].source = nan.cview();
   EXPECT_THROW(validate(in, p), Error);
+  // Infinities of either sign too, named at their pixel; the largest finite values pass.
+  for (const float bad :
+       {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()}) {
+    Image<float> inf = noise(32, 32, 1, 4);
+    inf(30, 17) = bad;
+    in = f.inputs();
+    in.guides[0].target = inf.cview();
+    try {
+      validate(in, p);
+      FAIL() << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("(30, 17)"), std::string::npos) << e.what();
+    }
+  }
+  Image<float> large = noise(32, 32, 1, 4);
+  large(1, 1) = std::numeric_limits<float>::max();
+  large(2, 1) = -std::numeric_limits<float>::max();
+  large(3, 1) = std::numeric_limits<float>::denorm_min();
+  in = f.inputs();
+  in.guides[0].target = large.cview();
+  EXPECT_NO_THROW(validate(in, p));
   Image<float> tiny(4, 4, 1);
   in = f.inputs();
   in.guides[0].target = tiny.cview();
