@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "core/parallel.h"
@@ -25,31 +27,33 @@ Image<T> downsample_impl(ImageView<const T> in) {
     std::vector<float> tmp(std::size_t(r1 - r0 + 1) * row);
     for (int y = r0; y <= r1; ++y) {
       float* t = tmp.data() + std::size_t(y - r0) * row;
-      for (int x = 0; x < ow; ++x) {
-        const int xs[4] = {std::clamp(2 * x - 1, 0, w - 1), std::min(2 * x, w - 1),
-                           std::min(2 * x + 1, w - 1), std::min(2 * x + 2, w - 1)};
+      const T* in_row = in.row(y);
+      for (int x = 0; x < ow; ++x, t += c) {
+        const T* p0 = in_row + std::ptrdiff_t(std::clamp(2 * x - 1, 0, w - 1)) * c;
+        const T* p1 = in_row + std::ptrdiff_t(std::min(2 * x, w - 1)) * c;
+        const T* p2 = in_row + std::ptrdiff_t(std::min(2 * x + 1, w - 1)) * c;
+        const T* p3 = in_row + std::ptrdiff_t(std::min(2 * x + 2, w - 1)) * c;
         for (int k = 0; k < c; ++k)
-          t[std::size_t(x) * c + k] = (float(in(xs[0], y, k)) + 3.0f * float(in(xs[1], y, k)) +
-                                       3.0f * float(in(xs[2], y, k)) + float(in(xs[3], y, k))) *
-                                      0.125f;
+          t[k] = (float(p0[k]) + 3.0f * float(p1[k]) + 3.0f * float(p2[k]) + float(p3[k])) * 0.125f;
       }
     }
-    auto at = [&](int x, int y, int k) {
-      return tmp[std::size_t(y - r0) * row + std::size_t(x) * c + k];
-    };
     for (int y = y0; y < y1; ++y) {
-      const int ys[4] = {std::clamp(2 * y - 1, 0, h - 1), std::min(2 * y, h - 1),
-                         std::min(2 * y + 1, h - 1), std::min(2 * y + 2, h - 1)};
-      for (int x = 0; x < ow; ++x)
-        for (int k = 0; k < c; ++k) {
-          const float v = (at(x, ys[0], k) + 3.0f * at(x, ys[1], k) + 3.0f * at(x, ys[2], k) +
-                           at(x, ys[3], k)) *
-                          0.125f;
-          if constexpr (std::is_integral_v<T>)
-            out(x, y, k) = T(std::lround(v));
-          else
-            out(x, y, k) = v;
+      const auto tmp_row = [&](int ry) { return tmp.data() + std::size_t(ry - r0) * row; };
+      const float* q0 = tmp_row(std::clamp(2 * y - 1, 0, h - 1));
+      const float* q1 = tmp_row(std::min(2 * y, h - 1));
+      const float* q2 = tmp_row(std::min(2 * y + 1, h - 1));
+      const float* q3 = tmp_row(std::min(2 * y + 2, h - 1));
+      T* o = out.row(y);
+      for (std::size_t i = 0; i < row; ++i) {
+        const float v = (q0[i] + 3.0f * q1[i] + 3.0f * q2[i] + q3[i]) * 0.125f;
+        if constexpr (std::is_integral_v<T>) {
+          // std::lround's halves away from zero, exact in double, without the call.
+          const double d = double(v);
+          o[i] = T(int64_t(d + (d >= 0.0 ? 0.5 : -0.5)));
+        } else {
+          o[i] = v;
         }
+      }
     }
   });
   return out;

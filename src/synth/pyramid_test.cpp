@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "synth/synthesizer.h"
@@ -45,6 +47,46 @@ TEST(Pyramid, ConstantStaysConstantAndSizesHalve) {
 TEST(Pyramid, LevelCountFollowsPatchSize) {
   EXPECT_EQ(max_pyramid_levels(1200, 912, 1200, 912, 5), 7);
   EXPECT_EQ(max_pyramid_levels(20, 20, 20, 20, 5), 1);
+}
+
+// The [1 3 3 1] / 8 filter each way, borders clamped, integers rounded half away from zero
+// (std::lround): odd and even sizes, 1 to 16 channels, negative values and exact halves.
+TEST(Pyramid, DownsampleIsTheFilterTapByTap) {
+  CounterRng rng(21);
+  for (const int c : {1, 3, 8, 16})
+    for (const auto& [w, h] : {std::pair{9, 7}, std::pair{16, 10}, std::pair{1, 5}}) {
+      Image<int16_t> ints(w, h, c);
+      Image<float> floats(w, h, c);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+          for (int k = 0; k < c; ++k) {
+            // Multiples of 4 from -64 to 60 give sums that land on halves.
+            ints(x, y, k) = int16_t(4 * int(rng.uniform(32)) - 64);
+            floats(x, y, k) = rng.uniform_float() * 2.0f - 1.0f;
+          }
+      const Image<int16_t> di = downsample(ints.cview());
+      const Image<float> df = downsample(floats.cview());
+      const int ow = (w + 1) / 2, oh = (h + 1) / 2;
+      ASSERT_EQ(di.width(), ow);
+      ASSERT_EQ(di.height(), oh);
+      const auto filter = [&](const auto& im, int x, int y, int k) {
+        float rows[4];
+        for (int j = 0; j < 4; ++j) {
+          const int v = std::clamp(2 * y - 1 + j, 0, h - 1);
+          const auto at = [&](int u) { return float(im(std::clamp(u, 0, w - 1), v, k)); };
+          rows[j] =
+              (at(2 * x - 1) + 3.0f * at(2 * x) + 3.0f * at(2 * x + 1) + at(2 * x + 2)) * 0.125f;
+        }
+        return (rows[0] + 3.0f * rows[1] + 3.0f * rows[2] + rows[3]) * 0.125f;
+      };
+      for (int y = 0; y < oh; ++y)
+        for (int x = 0; x < ow; ++x)
+          for (int k = 0; k < c; ++k) {
+            ASSERT_EQ(di(x, y, k), int16_t(std::lround(filter(ints, x, y, k))))
+                << c << " channels " << w << "x" << h << " at " << x << "," << y;
+            ASSERT_EQ(df(x, y, k), filter(floats, x, y, k));
+          }
+    }
 }
 
 }  // namespace
