@@ -35,6 +35,13 @@ Image<float> halve(Image<float> im, int halvings) {
   return im;
 }
 
+// halve(to_float(plane)), a float plane halved from where it lies, not from a copy.
+Image<float> halve(const synth::Plane& plane, int halvings) {
+  const auto* f = std::get_if<ImageView<const float>>(&plane);
+  if (f == nullptr || halvings <= 0) return halve(to_float(plane), halvings);
+  return halve(synth::downsample(*f), halvings - 1);
+}
+
 // Bilinear, pixel centres aligned.
 float sample(const Image<float>& im, float x, float y, int c) {
   x = std::clamp(x, 0.0f, float(im.width() - 1));
@@ -71,8 +78,8 @@ AnchorExemplar anchor_exemplar(const synth::Plane& style, const std::vector<synt
   CHECK_GE(halvings, 1);
   AnchorExemplar e;
   e.halvings = halvings;
-  e.planes.push_back(halve(to_float(style), halvings));
-  for (const synth::Plane& p : sources) e.planes.push_back(halve(to_float(p), halvings));
+  e.planes.push_back(halve(style, halvings));
+  for (const synth::Plane& p : sources) e.planes.push_back(halve(p, halvings));
   return e;
 }
 
@@ -85,7 +92,7 @@ Anchor anchor_tone(const synth::Inputs& inputs, const AnchorExemplar& exemplar,
   std::vector<Image<float>> keep;
   keep.reserve(2 * inputs.guides.size());
   auto small = [&](const synth::Plane& p) -> synth::Plane {
-    keep.push_back(halve(to_float(p), halvings));
+    keep.push_back(halve(p, halvings));
     return synth::Plane(keep.back().cview());
   };
   synth::Inputs s;
