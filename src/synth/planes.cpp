@@ -11,6 +11,7 @@
 #include <mutex>
 #include <vector>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
 
@@ -33,24 +34,53 @@ void plane_range(const Plane& p, int c, float& lo, float& hi) {
   hi = std::max(hi, h[std::size_t(c)]);
 }
 
+namespace {
+
+// The band's rows' [min, max] per channel, NC channels (1 to 4) known at compile time so that
+// the running values stay in registers.
+template <int NC>
+void band_ranges(const Plane& p, int y0, int y1, float* lo, float* hi) {
+  const int w = plane_width(p);
+  float l[NC], h[NC];
+  for (int c = 0; c < NC; ++c) l[c] = INFINITY, h[c] = -INFINITY;
+  for_each_row(p, y0, y1, [&](int, const float* row) {
+    for (int x = 0; x < w; ++x, row += NC)
+      for (int c = 0; c < NC; ++c) {
+        l[c] = std::min(l[c], row[c]);
+        h[c] = std::max(h[c], row[c]);
+      }
+  });
+  for (int c = 0; c < NC; ++c) lo[c] = l[c], hi[c] = h[c];
+}
+
+}  // namespace
+
 void plane_ranges(const Plane& p, std::vector<float>& lo, std::vector<float>& hi) {
-  const int nc = plane_channels(p), w = plane_width(p);
+  const int nc = plane_channels(p);
+  CHECK(nc >= 1 && nc <= 4);
   lo.assign(std::size_t(nc), INFINITY);
   hi.assign(std::size_t(nc), -INFINITY);
   std::mutex m;
   parallel_rows(plane_height(p), 32, [&](int y0, int y1) {
-    std::vector<float> l(std::size_t(nc), INFINITY), h(std::size_t(nc), -INFINITY);
-    for_each_row(p, y0, y1, [&](int, const float* row) {
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < nc; ++c) {
-          l[std::size_t(c)] = std::min(l[std::size_t(c)], row[x * nc + c]);
-          h[std::size_t(c)] = std::max(h[std::size_t(c)], row[x * nc + c]);
-        }
-    });
+    float l[4], h[4];
+    switch (nc) {
+      case 1:
+        band_ranges<1>(p, y0, y1, l, h);
+        break;
+      case 2:
+        band_ranges<2>(p, y0, y1, l, h);
+        break;
+      case 3:
+        band_ranges<3>(p, y0, y1, l, h);
+        break;
+      default:
+        band_ranges<4>(p, y0, y1, l, h);
+        break;
+    }
     std::lock_guard lock(m);
     for (int c = 0; c < nc; ++c) {
-      lo[std::size_t(c)] = std::min(lo[std::size_t(c)], l[std::size_t(c)]);
-      hi[std::size_t(c)] = std::max(hi[std::size_t(c)], h[std::size_t(c)]);
+      lo[std::size_t(c)] = std::min(lo[std::size_t(c)], l[c]);
+      hi[std::size_t(c)] = std::max(hi[std::size_t(c)], h[c]);
     }
   });
 }

@@ -41,7 +41,7 @@ void for_each_row(const Plane& plane, int y0, int y1, Fn&& fn) {
 // Widens [lo, hi] to the values of channel c. Min and max are exact and order-free, so bands
 // may combine in any order.
 void plane_range(const Plane& p, int c, float& lo, float& hi);
-// Every channel's [min, max] in one pass (+inf, -inf for an empty plane).
+// Every channel's [min, max] in one pass (+inf, -inf for an empty plane); 1 to 4 channels.
 void plane_ranges(const Plane& p, std::vector<float>& lo, std::vector<float>& hi);
 
 // A float plane's first non-finite value (NaN or Inf) is an Error naming `name` and the pixel.
