@@ -1,7 +1,6 @@
 #include "synth/voting.h"
 
 #include <algorithm>
-#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -175,39 +174,24 @@ void vote(const Plane& source, const Image<int32_t>& nnf, const Image<float>& er
 }
 
 Image<uint8_t> dilate_mask(const Image<uint8_t>& inside, int radius) {
-  const int w = inside.width(), h = inside.height(), r = std::max(radius, 0);
+  const int w = inside.width(), h = inside.height(), r = radius;
   Image<uint8_t> across(w, h, 1), out(w, h, 1);
-  // A pixel is set when the nearest set pixel before or after it (in its row, then in its
-  // column) is at most r away: two sweeps each way, whatever the radius.
-  constexpr int kFar = std::numeric_limits<int>::max() / 2;
   parallel_rows(h, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y) {
-      int last = -kFar;
+    for (int y = y0; y < y1; ++y)
       for (int x = 0; x < w; ++x) {
-        if (inside(x, y)) last = x;
-        across(x, y) = x - last <= r ? 1 : 0;
+        uint8_t v = 0;
+        for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r) && !v; ++xx)
+          v = inside(xx, y) ? 1 : 0;
+        across(x, y) = v;
       }
-      int next = kFar;
-      for (int x = w - 1; x >= 0; --x) {
-        if (inside(x, y)) next = x;
-        if (next - x <= r) across(x, y) = 1;
-      }
-    }
   });
-  // The columns in blocks, each swept down and up row by row.
-  parallel_for(w, 256, [&](int64_t c0, int64_t c1) {
-    const int x0 = int(c0), n = int(c1 - c0);
-    std::vector<int> mark(std::size_t(n), -kFar);
-    for (int y = 0; y < h; ++y)
-      for (int i = 0; i < n; ++i) {
-        if (across(x0 + i, y)) mark[i] = y;
-        out(x0 + i, y) = y - mark[i] <= r ? 1 : 0;
-      }
-    std::fill(mark.begin(), mark.end(), kFar);
-    for (int y = h - 1; y >= 0; --y)
-      for (int i = 0; i < n; ++i) {
-        if (across(x0 + i, y)) mark[i] = y;
-        if (mark[i] - y <= r) out(x0 + i, y) = 1;
+  parallel_rows(h, 32, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t v = 0;
+        for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r) && !v; ++yy)
+          v = across(x, yy);
+        out(x, y) = v;
       }
   });
   return out;
