@@ -66,10 +66,21 @@ std::unique_ptr<FrameSource> scene_frames(scene::Scene scene, const Source& sour
 Image<float> extract(ImageView<const float> passes, int first, int count) {
   CHECK_LE(first + count, passes.channels);
   Image<float> out(passes.width, passes.height, count);
+  const int step = passes.channels, w = passes.width;
   parallel_rows(passes.height, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < passes.width; ++x)
-        for (int c = 0; c < count; ++c) out(x, y, c) = passes(x, y, first + c);
+    for (int y = y0; y < y1; ++y) {
+      const float* in = passes.row(y) + first;
+      float* o = out.row(y);
+      if (count == passes.channels) {
+        std::copy(in, in + std::ptrdiff_t(w) * count, o);
+      } else if (count == 1) {
+        for (int x = 0; x < w; ++x) o[x] = in[std::ptrdiff_t(x) * step];
+      } else if (count == 3) {
+        for (int x = 0; x < w; ++x, o += 3, in += step) o[0] = in[0], o[1] = in[1], o[2] = in[2];
+      } else {
+        for (int x = 0; x < w; ++x, o += count, in += step) std::copy(in, in + count, o);
+      }
+    }
   });
   return out;
 }
