@@ -27,13 +27,6 @@ int plane_channels(const Plane& p) {
   return std::visit([](const auto& v) { return v.channels; }, p);
 }
 
-void plane_range(const Plane& p, int c, float& lo, float& hi) {
-  std::vector<float> l, h;
-  plane_ranges(p, l, h);
-  lo = std::min(lo, l[std::size_t(c)]);
-  hi = std::max(hi, h[std::size_t(c)]);
-}
-
 namespace {
 
 // The band's rows' [min, max] per channel, NC channels (1 to 4) known at compile time so that
@@ -58,8 +51,8 @@ void band_ranges(const Plane& p, int y0, int y1, float* lo, float* hi) {
 void plane_ranges(const Plane& p, std::vector<float>& lo, std::vector<float>& hi) {
   const int nc = plane_channels(p);
   CHECK(nc >= 1 && nc <= 4);
-  lo.assign(std::size_t(nc), INFINITY);
-  hi.assign(std::size_t(nc), -INFINITY);
+  CHECK_EQ(lo.size(), std::size_t(nc));
+  CHECK_EQ(hi.size(), std::size_t(nc));
   std::mutex m;
   parallel_rows(plane_height(p), 32, [&](int y0, int y1) {
     float l[4], h[4];

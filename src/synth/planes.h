@@ -19,7 +19,7 @@ inline bool is_float(const Plane& p) {
 
 // Calls fn(y, const float* values) per row of rows [y0, y1), the values normalised. Float rows
 // are handed over in place (normalised() leaves floats as they are): copying them was a second
-// pass over every guide, once per channel in plane_range.
+// pass over every guide, once per channel in plane_ranges.
 template <typename Fn>
 void for_each_row(const Plane& plane, int y0, int y1, Fn&& fn) {
   if (const auto* f = std::get_if<ImageView<const float>>(&plane)) {
@@ -38,10 +38,8 @@ void for_each_row(const Plane& plane, int y0, int y1, Fn&& fn) {
       plane);
 }
 
-// Widens [lo, hi] to the values of channel c. Min and max are exact and order-free, so bands
-// may combine in any order.
-void plane_range(const Plane& p, int c, float& lo, float& hi);
-// Every channel's [min, max] in one pass (+inf, -inf for an empty plane); 1 to 4 channels.
+// Widens each channel's [lo[c], hi[c]] (one entry per channel, 1 to 4) to the plane's values, in
+// one pass. Min and max are exact and order-free, so bands may combine in any order.
 void plane_ranges(const Plane& p, std::vector<float>& lo, std::vector<float>& hi);
 
 // A float plane's first non-finite value (NaN or Inf) is an Error naming `name` and the pixel.

@@ -48,15 +48,9 @@ FeatureLayout make_layout(const Inputs& in, const Params& p) {
       range.insert(range.end(), std::size_t(nc), {0.0f, 1.0f});
       return;
     }
-    std::vector<float> mn, mx, b_mn, b_mx;
+    std::vector<float> mn(std::size_t(nc), INFINITY), mx(std::size_t(nc), -INFINITY);
     plane_ranges(a, mn, mx);
-    if (b) {
-      plane_ranges(*b, b_mn, b_mx);
-      for (int c = 0; c < nc; ++c) {
-        mn[std::size_t(c)] = std::min(mn[std::size_t(c)], b_mn[std::size_t(c)]);
-        mx[std::size_t(c)] = std::max(mx[std::size_t(c)], b_mx[std::size_t(c)]);
-      }
-    }
+    if (b) plane_ranges(*b, mn, mx);
     for (int c = 0; c < nc; ++c) {
       const float lo = mn[std::size_t(c)], hi = mx[std::size_t(c)];
       if (lo < 0.0f || hi > 1.0f)
@@ -94,7 +88,7 @@ void quantize_plane(const Plane& plane, const FeatureLayout& L, int c0, Image<in
   const int nc = plane_channels(plane), w = plane_width(plane);
   const ChannelMap* map = L.map.data() + c0;
   const std::ptrdiff_t step = feat.channels();
-  // The channel count fixed at compile time for the common planes, so the maps stay in registers.
+  // The channel count fixed at compile time, so the maps stay in registers.
   const auto rows = [&]<int NC>(std::integral_constant<int, NC>) {
     parallel_rows(plane_height(plane), 32, [&](int y0, int y1) {
       ChannelMap m[NC];
@@ -106,26 +100,17 @@ void quantize_plane(const Plane& plane, const FeatureLayout& L, int c0, Image<in
       });
     });
   };
-  switch (nc) {
+  switch (nc) {  // 1 to 4, as validate() allows
     case 1:
       return rows(std::integral_constant<int, 1>{});
     case 2:
       return rows(std::integral_constant<int, 2>{});
     case 3:
       return rows(std::integral_constant<int, 3>{});
-    case 4:
-      return rows(std::integral_constant<int, 4>{});
     default:
-      break;
+      CHECK_EQ(nc, 4);
+      return rows(std::integral_constant<int, 4>{});
   }
-  parallel_rows(plane_height(plane), 32, [&](int y0, int y1) {
-    for_each_row(plane, y0, y1, [&](int y, const float* row) {
-      for (int x = 0; x < w; ++x) {
-        int16_t* f = feat.at(x + off, y + off);
-        for (int c = 0; c < nc; ++c) f[c0 + c] = map[c].quantize(row[x * nc + c]);
-      }
-    });
-  });
 }
 
 void write_style(const Image<float>& style, const FeatureLayout& L, Image<int16_t>& tgt,
