@@ -74,19 +74,11 @@ void blur_pass(const Image<float>& in, const Image<float>& in_w, Image<float>& o
           const float* row = in.row(v);
           const float* row_w = in_w.row(v);
           const double kw = double(k[i + r]);
-          if (n == 1) {
-            for (int x = 0; x < w; ++x) {
-              const double wt = kw * row_w[x];
-              sum[std::size_t(x)] += wt;
-              acc[std::size_t(x)] += wt * row[x];
-            }
-          } else {
-            for (int x = 0; x < w; ++x) {
-              const double wt = kw * row_w[x];
-              sum[std::size_t(x)] += wt;
-              for (int c = 0; c < n; ++c)
-                acc[std::size_t(x) * n + c] += wt * row[std::size_t(x) * n + c];
-            }
+          for (int x = 0; x < w; ++x) {
+            const double wt = kw * row_w[x];
+            sum[std::size_t(x)] += wt;
+            for (int c = 0; c < n; ++c)
+              acc[std::size_t(x) * n + c] += wt * row[std::size_t(x) * n + c];
           }
         }
       }
