@@ -69,27 +69,53 @@ Image<uint8_t> visible_before(const Surfaces& s, float tolerance) {
 
 namespace {
 
-Image<float> box_share(ImageView<const float> ids, float k, int radius) {
+// Where an object id shows in a frame: its pixels' bounding box, inclusive.
+struct IdBox {
+  float id;
+  int x0, y0, x1, y1;
+};
+
+// The share of the pixels within `radius` of each pixel (clamped window) that show `b.id`: the
+// mean of per-row shares over the window's rows, in order from the top. Computed only where a
+// pixel of the id is within reach (its box grown by `radius`): elsewhere every row share is 0,
+// and so is the result, as the calloc'd image holds it. Skipping those rows' zeros in a sum of
+// non-negative values changes no bit.
+Image<float> box_share(ImageView<const float> ids, const IdBox& b, int radius) {
   const int w = ids.width, h = ids.height;
+  const int x0 = std::max(0, b.x0 - radius), x1 = std::min(w - 1, b.x1 + radius);
+  const int y0 = std::max(0, b.y0 - radius), y1 = std::min(h - 1, b.y1 + radius);
   Image<float> rows(w, h, 1), out(w, h, 1);
-  parallel_rows(h, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        int n = 0, hit = 0;
-        for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
-          ++n, hit += ids(u, y, 3) == k ? 1 : 0;
-        rows(x, y) = float(hit) / float(n);
+  // Rows: the hits within the window, counted by sliding it along the row (integers: exact).
+  parallel_rows(b.y1 - b.y0 + 1, 32, [&](int r0, int r1) {
+    for (int y = b.y0 + r0; y < b.y0 + r1; ++y) {
+      const float* src = ids.row(y);
+      float* dst = rows.row(y);
+      auto hit = [&](int u) { return src[std::size_t(u) * std::size_t(ids.channels) + 3] == b.id; };
+      int count = 0;
+      // The window of x0 - 1, which the first step below slides to x0's.
+      for (int u = std::max(0, x0 - radius - 1); u <= std::min(w - 1, x0 + radius - 1); ++u)
+        count += hit(u);
+      for (int x = x0; x <= x1; ++x) {
+        if (x + radius < w) count += hit(x + radius);
+        if (x - radius - 1 >= 0) count -= hit(x - radius - 1);
+        const int n = std::min(w - 1, x + radius) - std::max(0, x - radius) + 1;
+        dst[x] = float(count) / float(n);
       }
+    }
   });
-  parallel_rows(h, 32, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < w; ++x) {
-        float sum = 0.0f;
-        int n = 0;
-        for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v)
-          ++n, sum += rows(x, v);
-        out(x, y) = sum / float(n);
+  // Columns: each pixel's sum over the window's rows from the top, a row at a time.
+  parallel_rows(y1 - y0 + 1, 32, [&](int r0, int r1) {
+    std::vector<float> sum(std::size_t(x1 - x0 + 1));
+    for (int y = y0 + r0; y < y0 + r1; ++y) {
+      std::fill(sum.begin(), sum.end(), 0.0f);
+      for (int v = std::max({0, y - radius, b.y0}); v <= std::min({h - 1, y + radius, b.y1}); ++v) {
+        const float* src = rows.row(v) + x0;
+        for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += src[i];
       }
+      const float n = float(std::min(h - 1, y + radius) - std::max(0, y - radius) + 1);
+      float* dst = out.row(y) + x0;
+      for (std::size_t i = 0; i < sum.size(); ++i) dst[i] = sum[i] / n;
+    }
   });
   return out;
 }
@@ -99,23 +125,42 @@ Image<float> box_share(ImageView<const float> ids, float k, int radius) {
 IdShares id_shares(ImageView<const float> ids, int radius) {
   IdShares s;
   s.radius = radius;
-  // The ids of each band of rows in first-seen order, then merged in band order: the order of a
-  // scan of the whole image row by row.
+  // The ids of each band of rows in first-seen order with their boxes, then merged in band
+  // order: the order of a scan of the whole image row by row.
   const int band = 32, bands = (ids.height + band - 1) / band;
-  std::vector<std::vector<float>> seen(std::size_t(std::max(bands, 0)));
+  std::vector<std::vector<IdBox>> seen(std::size_t(std::max(bands, 0)));
   parallel_for(bands, 1, [&](int64_t b0, int64_t b1) {
-    for (int64_t b = b0; b < b1; ++b)
+    for (int64_t b = b0; b < b1; ++b) {
+      std::vector<IdBox>& v = seen[std::size_t(b)];
       for (int y = int(b) * band; y < std::min(ids.height, int(b + 1) * band); ++y)
         for (int x = 0; x < ids.width; ++x) {
           const float k = ids(x, y, 3);
-          std::vector<float>& v = seen[std::size_t(b)];
-          if (std::find(v.begin(), v.end(), k) == v.end()) v.push_back(k);
+          auto it = std::find_if(v.begin(), v.end(), [k](const IdBox& e) { return e.id == k; });
+          if (it == v.end()) {
+            v.push_back({k, x, y, x, y});
+          } else {
+            it->x0 = std::min(it->x0, x), it->x1 = std::max(it->x1, x);
+            it->y1 = y;
+          }
         }
+    }
   });
-  for (const std::vector<float>& v : seen)
-    for (float k : v)
-      if (std::find(s.ids.begin(), s.ids.end(), k) == s.ids.end()) s.ids.push_back(k);
-  for (float k : s.ids) s.share.push_back(box_share(ids, k, radius));
+  std::vector<IdBox> boxes;
+  for (const std::vector<IdBox>& v : seen)
+    for (const IdBox& e : v) {
+      auto it =
+          std::find_if(boxes.begin(), boxes.end(), [&](const IdBox& o) { return o.id == e.id; });
+      if (it == boxes.end()) {
+        boxes.push_back(e);
+      } else {
+        it->x0 = std::min(it->x0, e.x0), it->x1 = std::max(it->x1, e.x1);
+        it->y0 = std::min(it->y0, e.y0), it->y1 = std::max(it->y1, e.y1);
+      }
+    }
+  for (const IdBox& b : boxes) {
+    s.ids.push_back(b.id);
+    s.share.push_back(box_share(ids, b, radius));
+  }
   return s;
 }
 

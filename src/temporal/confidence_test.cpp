@@ -122,6 +122,41 @@ TEST(Confidence, ForeignShareOverAMaskIsTheMaskedFields) {
   EXPECT_GT(inside, 0);
 }
 
+// id_shares against its definition written pixel by pixel (the share of the clamped window's
+// pixels showing each id: the mean over the window's rows, from the top, of each row's share),
+// bit for bit: objects of every size, at the borders, one of a single pixel, at radii 0-4.
+TEST(Confidence, IdSharesAreTheWindowMeansOfEachId) {
+  const int w = 41, h = 29;
+  Image<float> ids(w, h, 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float k = 0.0f;
+      if (x < 6 && y > 20) k = 3.0f;                                 // a corner
+      if ((x - 20) * (x - 20) + (y - 12) * (y - 12) < 40) k = 7.0f;  // a disc
+      if (x > 30 && (x + y) % 3 == 0) k = 5.0f;                      // stripes at the edge
+      if (x == 12 && y == 3) k = 9.0f;                               // one pixel
+      ids(x, y, 3) = k;
+    }
+  for (int radius = 0; radius <= 4; ++radius) {
+    const IdShares s = id_shares(ids.cview(), radius);
+    ASSERT_EQ(s.ids, (std::vector<float>{0.0f, 5.0f, 9.0f, 7.0f, 3.0f})) << radius;
+    for (std::size_t i = 0; i < s.ids.size(); ++i)
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          float sum = 0.0f;
+          int rows = 0;
+          for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v, ++rows) {
+            int n = 0, hit = 0;
+            for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
+              ++n, hit += ids(u, v, 3) == s.ids[i] ? 1 : 0;
+            sum += float(hit) / float(n);
+          }
+          ASSERT_EQ(s.share[i](x, y), sum / float(rows))
+              << "id " << s.ids[i] << " radius " << radius << " at " << x << "," << y;
+        }
+  }
+}
+
 TEST(Confidence, ErrorRampAndErosion) {
   Image<uint8_t> visible(9, 1, 1);
   Image<float> foreign(9, 1, 1), error(9, 1, 1);
