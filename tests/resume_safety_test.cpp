@@ -138,7 +138,7 @@ TEST_F(ResumeSafety, TruncatedCacheAndLayerFilesAreReplacedByRunForce) {
   expect_ok(emaki("task prepare shot.toml"));
   expect_ok(emaki("task passes shot.toml --frames 0-2"));
   expect_ok(emaki("run shot.toml"));
-  cut_to_half(p("shot/out/passes/frame_0001.exr"));
+  cut_to_half(p("shot/out/passes/frame_0001.passes"));
   cut_to_half(p("shot/out/layers/base/base_0001.exr"));
   cut_to_half(p("shot/out/composite/frame_0002.png"));
   const test::CliResult r = emaki("run --force shot.toml");

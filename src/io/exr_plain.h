@@ -1,8 +1,8 @@
 // emaki's own reader and writer for the EXR files it writes: one scanline part, uncompressed or
 // ZIP (zlib), channels of 32-bit float or half sampled at every pixel. Every EXR emaki writes
-// (layers, the layered and composite frames, renders, its pass cache and reference passes) is
-// such a file, and reading them back (the pass cache and references in every farm task, the
-// layers in a composite task) needs neither a decoder library nor a full-size staging buffer.
+// (layers, the layered and composite frames, renders) is such a file, and reading them back (the
+// layers in a composite task, the previous layer frame in a layer task) needs neither a decoder
+// library nor a full-size staging buffer.
 // OpenImageIO, with the ~260 libraries it loads (0.25-0.45 CPU-s a process), is then needed
 // only for other files: a studio's renders, TIFF, JPEG. Through it, a 1200x912 frame of 24
 // float passes cost 1.3 CPU-s to read, against 0.16 here.

@@ -68,12 +68,6 @@ std::vector<std::string> list_channels_memory(const void* data, std::size_t size
 
 enum class SampleFormat { kAuto, kU8, kU16, kHalf, kFloat };
 
-// The compression of EXRs that only emaki reads back (the pass cache, reference passes), where a
-// user's files keep "zip". None: at 480x270 a frame of passes (24 float channels) takes 12.4 MB
-// against zip's 3.2 MB (rle 7.1, piz 3.6), and a farm's passes tasks wrote 12 frames in 1.6-1.9
-// CPU-s against zip's 4.6 (rle 1.9-2.5, piz 3.6); reading back cost no more than zip's.
-inline constexpr const char* kIntermediateCompression = "none";
-
 struct WriteOptions {
   // kAuto: 16-bit for PNG/TIFF, half for EXR, 8-bit for JPEG.
   SampleFormat format = SampleFormat::kAuto;

@@ -20,6 +20,7 @@
 #include "render/passes.h"
 #include "store/field_file.h"
 #include "store/kept_fields.h"
+#include "store/mapped_passes.h"
 #include "store/qa_maps.h"
 #include "store/settings_manifests.h"
 
@@ -52,8 +53,8 @@ std::string OutputPaths::mp4() const {
 std::string OutputPaths::contact_sheet() const {
   return folder + "/contact_sheet.png";
 }
-std::string OutputPaths::passes_exr(int frame) const {
-  return fmt::format("{}/passes/frame_{:04d}.exr", folder, frame);
+std::string OutputPaths::passes_file(int frame) const {
+  return fmt::format("{}/passes/frame_{:04d}.passes", folder, frame);
 }
 std::string OutputPaths::passes_fields(int frame) const {
   return fmt::format("{}/passes/advection_{:04d}.field", folder, frame);
@@ -104,7 +105,7 @@ bool is_layer_file(const std::string& name, const std::string& layer) {
 
 // The pass cache's frames and the advection fields beside them.
 void remove_pass_cache(const std::string& dir) {
-  remove_frames(dir, "frame_", {".exr"});
+  remove_frames(dir, "frame_", {".passes", ".exr"});  // .exr: the cache's earlier form
   remove_frames(dir, "advection_", {".field"});
 }
 
@@ -255,7 +256,8 @@ bool FileStore::prepared(bool with_pass_cache) const {
 }
 
 bool FileStore::has_passes(int frame) const {
-  return passes_.current && image_file_complete(paths_.passes_exr(frame));
+  return passes_.current &&
+         mapped_passes_complete(paths_.passes_file(frame), shot_.source.width, shot_.source.height);
 }
 
 void FileStore::write_passes(int frame, ImageView<const float> passes) {
@@ -263,11 +265,7 @@ void FileStore::write_passes(int frame, ImageView<const float> passes) {
   const fs::path dir = fs::path(paths_.folder) / "passes";
   make_folder(dir);
   make_current(passes_, dir.string(), remove_pass_cache);
-  WriteOptions exr;
-  exr.format = SampleFormat::kFloat;  // bit for bit: every task reads the same floats
-  exr.channel_names = render::channel_names();
-  exr.compression = kIntermediateCompression;
-  write_image(paths_.passes_exr(frame), passes, exr);
+  write_mapped_passes(paths_.passes_file(frame), passes);
 }
 
 void FileStore::write_kept_fields(int frame, const std::vector<pipeline::KeptField>& fields) {
@@ -474,22 +472,10 @@ class CachedFrames : public pipeline::FrameSource {
         inner_(std::move(inner)) {}
   // A cached frame that is missing, cut short or unreadable is rendered instead (the cache holds
   // exactly what rendering gives): a damaged cache never stops a run, `--force` or not.
-  // The file is opened once: checked whole and decoded through the same open.
+  // The file is mapped, not read (store/mapped_passes.h); one of another size is not used.
   Image<float> passes(int frame) const override {
-    const std::string file = paths_.passes_exr(frame);
-    Image<float> img;
-    try {
-      std::optional<AnyImage> read =
-          read_image_if_complete(file, ReadOptions{render::channel_names()});
-      if (!read) return inner_->passes(frame);
-      img = std::move(*read).to_float();
-    } catch (const Error&) {
-      return inner_->passes(frame);
-    }
-    if (img.width() != width_ || img.height() != height_)
-      throw Error(file, fmt::format("is {}x{}, the shot makes {}x{}; {}", img.width(), img.height(),
-                                    width_, height_, kRedoHint));
-    return img;
+    std::optional<Image<float>> mapped = map_passes(paths_.passes_file(frame), width_, height_);
+    return mapped ? std::move(*mapped) : inner_->passes(frame);
   }
   // A file that is missing, cut short or damaged gives none: the layers compute theirs. It is
   // mapped, not read: nothing is allocated for what a file claims before it is checked.

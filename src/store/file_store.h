@@ -37,7 +37,7 @@ struct OutputPaths {
   std::string layered_exr(int frame) const;
   std::string mp4() const;
   std::string contact_sheet() const;
-  std::string passes_exr(int frame) const;  // the farm's pass cache
+  std::string passes_file(int frame) const;  // the farm's pass cache (store/mapped_passes.h)
   // Beside a frame's cached passes: its advection fields (store/kept_fields.h).
   std::string passes_fields(int frame) const;
 };
@@ -70,7 +70,7 @@ class FileStore : public pipeline::Store {
   // made with other settings: what the farm's prepare task does before the other tasks run.
   void prepare();
   // The pass cache: a scene source's guide passes per frame, rendered once and read by every
-  // task of the shot (float EXR, so read back bit for bit).
+  // task of the shot (floats as in memory, read by mapping the file: store/mapped_passes.h).
   bool has_passes(int frame) const;
   // Every manifest the farm's tasks write under is current (the pass cache's only when
   // `with_pass_cache`): the prepare task has nothing left to do.

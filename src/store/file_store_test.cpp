@@ -65,7 +65,7 @@ TEST_F(FileStoreTest, PathsFollowTheDocumentedLayout) {
   EXPECT_EQ(p.layered_exr(12), out + "/layered/frame_0012.exr");
   EXPECT_EQ(p.mp4(), out + "/preview.mp4");
   EXPECT_EQ(p.contact_sheet(), out + "/contact_sheet.png");
-  EXPECT_EQ(p.passes_exr(3), out + "/passes/frame_0003.exr");
+  EXPECT_EQ(p.passes_file(3), out + "/passes/frame_0003.passes");
 }
 
 // A layer frame is read back bit for bit: resuming continues from exactly what was written.
