@@ -465,8 +465,12 @@ void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   static_assert(kRounds >= 2);
   const int rounds = std::min(bands, kRounds);
   // The window sums are computed once; each round's deltas are folded into them afterwards.
-  std::vector<int32_t> occ, occ_scratch;
-  if (occ_scale > 0.0f) occupancy_window_sums(L, p, occ, occ_scratch);
+  std::vector<int32_t> occ;
+  if (occ_scale > 0.0f) {
+    // The scratch goes before the sweeps' deltas are allocated: it is not needed past here.
+    std::vector<int32_t> scratch;
+    occupancy_window_sums(L, p, occ, scratch);
+  }
   const std::vector<int32_t> triangle = triangle_table(p);
   const Sweep sweep{L,
                     C,

@@ -460,12 +460,16 @@ Result Synthesizer::run(const OutputRequest& request) {
   res.schedule = schedule;
   res.index = std::move(index);
   const Level& F = pyr[0];
-  res.image = output_image(solve.style, st.mask, st.layout.style_channels, st.tw, st.th);
   if (request.nnf) res.nnf = active_nnf(solve.nnf, F.active, st.tw, st.th);
   if (request.error) {
     compute_errors(solve.pm_level(F), solve.pm_config(params.extra_pass_3x3 ? 3 : p));
     res.error = std::move(solve.err);
   }
+  // The finest level's features go before the output is made: the run is over.
+  pyr = std::vector<Level>();
+  // Without a mask the voted style is the output as it is (no copy of it alongside).
+  res.image = st.mask ? output_image(solve.style, st.mask, st.layout.style_channels, st.tw, st.th)
+                      : std::move(solve.style);
   return res;
 }
 
