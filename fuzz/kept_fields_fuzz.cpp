@@ -22,12 +22,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::memcpy(&w, data + 16, 4);
     std::memcpy(&h, data + 20, 4);
     if (w > 0 && w <= 64 && h > 0 && h <= 64) frame = f, width = w, height = h;
-    uint64_t digest = emaki::kFnvOffset;
-    for (std::size_t i = kHeader; i + 4 <= size; i += 4) {
-      uint32_t word;
-      std::memcpy(&word, data + i, 4);
-      digest = emaki::fnv1a_add(digest, word);
-    }
+    emaki::FnvLanes lanes;  // the file's digest (kept_fields.cpp)
+    lanes.add(data + kHeader, size - kHeader);
+    const uint64_t digest = lanes.value();
     std::memcpy(bytes.data() + kDigestAt, &digest, 8);
   }
   const std::vector<emaki::pipeline::KeptField> fields =
