@@ -70,20 +70,27 @@ same() {
   echo "$r"
 }
 
-# measure_run DIR: `emaki run` of each shot into DIR; adds to run_wall, run_cpu.
+# measure_run DIR: `emaki run` of each shot into DIR; adds to run_wall, run_cpu, and per stage
+# (its --timings, named as the tasks' kinds) to run_stage_wall, run_stage_cpu.
+declare -A stage_wall stage_cpu stage_n run_stage_wall run_stage_cpu
+for kind in prepare passes layer composite previews; do
+  stage_wall[$kind]=0 stage_cpu[$kind]=0 stage_n[$kind]=0
+  run_stage_wall[$kind]=0 run_stage_cpu[$kind]=0
+done
 measure_run() {
-  local s w c
+  local s w c kind
   copy_shots "$1"
   for s in $(shot_files "$1"); do
-    read -r w c < <(timed "$emaki" run "$s" --threads 1)
+    read -r w c < <(timed "$emaki" run "$s" --threads 1 --timings)
     run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
+    while read -r kind w c; do
+      run_stage_wall[$kind]=$(calc "${run_stage_wall[$kind]} + $w")
+      run_stage_cpu[$kind]=$(calc "${run_stage_cpu[$kind]} + $c")
+    done < <(awk '$1 == "emaki" && $2 == "run:" && $3 ~ /^(prepare|passes|layers|composite|previews)$/ {
+      sub(/^layers$/, "layer", $3); print $3, $4, $5 }' "$work/stderr")
   done
 }
 # measure_tasks DIR: the plan's tasks into DIR, stage by stage; adds to stage_wall, stage_cpu.
-declare -A stage_wall stage_cpu stage_n
-for kind in prepare passes layer composite previews; do
-  stage_wall[$kind]=0 stage_cpu[$kind]=0 stage_n[$kind]=0
-done
 measure_tasks() {
   local dir=$1 kind line w c  # `set --` below takes the positional parameters
   copy_shots "$dir"
@@ -136,15 +143,20 @@ tasks_wall=$(stage_total stage_wall) tasks_cpu=$(stage_total stage_cpu)
 
 echo "shots: $shots; $tasks tasks (chunk $chunk, 1 thread each)"
 [ "$reps" = 1 ] || echo "mean of $reps repetitions"
-printf '%-34s %9s %9s\n' "" "wall s" "CPU s"
-printf '%-34s %9.1f %9.1f\n' "emaki run of each shot, 1 thread" "$(mean "$run_wall")" \
-  "$(mean "$run_cpu")"
+# Per stage: `emaki run`'s own split (--timings; the process's start and exit fall outside it)
+# against the tasks of that kind, each a whole process.
+printf '%-22s %9s %9s %13s %13s %9s\n' "stage" "run wall" "run CPU" "tasks wall" "tasks CPU" \
+  "CPU ratio"
 for kind in prepare passes layer composite previews; do
-  printf '%-34s %9.1f %9.1f\n' "  tasks: $kind (${stage_n[$kind]})" \
-    "$(mean "${stage_wall[$kind]}")" "$(mean "${stage_cpu[$kind]}")"
+  ratio=$(awk -v t="${stage_cpu[$kind]}" -v r="${run_stage_cpu[$kind]}" \
+    'BEGIN { if (r > 0) printf "%.2fx", t / r; else print "n/a" }')
+  printf '%-22s %9.1f %9.1f %13.1f %13.1f %9s\n' "$kind (${stage_n[$kind]} tasks)" \
+    "$(mean "${run_stage_wall[$kind]}")" "$(mean "${run_stage_cpu[$kind]}")" \
+    "$(mean "${stage_wall[$kind]}")" "$(mean "${stage_cpu[$kind]}")" "$ratio"
 done
-printf '%-34s %9.1f %9.1f\n' "the plan's tasks one by one" "$(mean "$tasks_wall")" \
-  "$(mean "$tasks_cpu")"
+printf '%-22s %9.1f %9.1f %13.1f %13.1f %9s\n' "all (whole processes)" "$(mean "$run_wall")" \
+  "$(mean "$run_cpu")" "$(mean "$tasks_wall")" "$(mean "$tasks_cpu")" \
+  "$(calc "$tasks_cpu / $run_cpu")x"
 echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x CPU time"
 if [ "$reps" != 1 ]; then
   echo "per repetition:$ratios; median $(printf '%s\n' $ratios | sort -n |

@@ -393,32 +393,40 @@ def section_plan(a, build):
 
 def farm_rows(a, script, emaki, work, shots):
     """bench/farm_bench.sh without Slurm on `shots` (None: the production's), a.runs times
-    alternated: the table rows."""
+    alternated: the table's row, and the rows of the per-stage table."""
     env = dict(os.environ, FARM_BENCH_SLURM="0", FARM_BENCH_REPEAT=str(a.runs))
     if shots:
         env["FARM_BENCH_SHOTS"] = " ".join(shots)
     out = run_timed(["bash", script, emaki, work], env=env)["out"]
-    run = re.search(r"emaki run of each shot, 1 thread\s+([0-9.]+)\s+([0-9.]+)", out)
-    tasks = re.search(r"the plan's tasks one by one\s+([0-9.]+)\s+([0-9.]+)", out)
+    num = r"\s+([0-9.]+)"
+    total = re.search(r"all \(whole processes\)" + num * 4, out)
     n = re.search(r"; (\d+) tasks", out)
     same = re.search(r"tasks vs emaki run: (identical|DIFFERENT.*)", out)
-    if not (run and tasks and n and same):
+    stages = re.findall(r"^(prepare|passes|layer|composite|previews) \((\d+) tasks\)" + num * 4 +
+                        r"\s+(\S+)$", out, re.M)
+    if not (total and n and same and len(stages) == 5):
         sys.exit(f"performance.py: farm: unexpected output of {script}:\n{out}")
     what = ", ".join(shots) if shots else "examples/production (3 shots, 480x270, 60 frames)"
-    ratio = f"{float(tasks.group(2)) / float(run.group(2)):.2f}x"
+    run_cpu, tasks_cpu = float(total.group(2)), float(total.group(4))
+    ratio = f"{tasks_cpu / run_cpu:.2f}x"
     reps = re.search(r"per repetition: ([0-9. ]+); median ([0-9.]+)", out)
     if reps:
         ratio = f"{reps.group(2)}x ({', '.join(reps.group(1).split())})"
-    return [f"| {what} | {n.group(1)} | {float(run.group(2)):.1f} | {float(tasks.group(2)):.1f} "
-            f"| {ratio} | {same.group(1)} |"]
+    row = (f"| {what} | {n.group(1)} | {run_cpu:.1f} | {tasks_cpu:.1f} | {ratio} "
+           f"| {same.group(1)} |")
+    stage_rows = [f"| {what} | {k} | {c} | {float(rc):.1f} | {float(tc):.1f} | {r} |"
+                  for k, c, _, rc, _, tc, r in stages]
+    return [row], stage_rows
 
 
 def section_farm(a, emaki, tmp):
     script = os.path.join(ROOT, "bench", "farm_bench.sh")
-    rows = farm_rows(a, script, emaki, os.path.join(tmp, "farm"), None)
+    rows, stage_rows = farm_rows(a, script, emaki, os.path.join(tmp, "farm"), None)
     full = ["examples/fox/shot.toml", "examples/town/shot.toml"]
     if a.full:
-        rows += farm_rows(a, script, emaki, os.path.join(tmp, "farm_full"), full)
+        more, more_stages = farm_rows(a, script, emaki, os.path.join(tmp, "farm_full"), full)
+        rows += more
+        stage_rows += more_stages
     env = f"FARM_BENCH_SLURM=0 FARM_BENCH_REPEAT={a.runs}"
     commands = [f"{env} bench/farm_bench.sh"]
     if a.full:
@@ -433,8 +441,11 @@ def section_farm(a, emaki, tmp):
              "```sh"] + commands + ["```", "",
              "| shots | tasks | emaki run CPU s | tasks CPU s | tasks vs run (each run) | outputs |",
              "|---|---|---|---|---|---|"] + rows +
-            ["", "Per stage, and through Slurm on the private test cluster: the script's own "
-             "output."])
+            ["", "By stage: `emaki run --timings` splits the run's CPU time among the task kinds "
+             "(its process start and exit in none of them); each task is a whole process:", "",
+             "| shots | stage | tasks | emaki run CPU s | tasks CPU s | tasks vs run |",
+             "|---|---|---|---|---|---|"] + stage_rows +
+            ["", "Through Slurm on the private test cluster: the script's own output."])
 
 
 # Each section's function, called with (args, build folder, emaki, scratch folder).

@@ -12,6 +12,7 @@
 #include "apps/emaki/commands.h"
 #include "apps/emaki/shot_command.h"
 #include "core/error.h"
+#include "core/stage_clock.h"
 #include "shot/api.h"
 
 namespace emaki::app {
@@ -68,6 +69,20 @@ void print_maps(const pipeline::Shot& shot, const char* kind, const std::string&
                  kind, layer.c_str());
 }
 
+// --timings: one line per stage, then the total.
+void print_timings(const StageClock& clock) {
+  std::fprintf(stderr, "emaki run: %-10s %9s %9s\n", "stage", "wall s", "CPU s");
+  StageClock::Seconds total;
+  for (int k = 0; k < StageClock::kStageCount; ++k) {
+    const auto s = StageClock::Stage(k);
+    const StageClock::Seconds t = clock.seconds(s);
+    std::fprintf(stderr, "emaki run: %-10s %9.2f %9.2f\n", StageClock::name(s), t.wall, t.cpu);
+    total.wall += t.wall;
+    total.cpu += t.cpu;
+  }
+  std::fprintf(stderr, "emaki run: %-10s %9.2f %9.2f\n", "total", total.wall, total.cpu);
+}
+
 }  // namespace
 
 int run_run(const Args& args) {
@@ -87,14 +102,21 @@ int run_run(const Args& args) {
   app.add_flag("--error-maps", error_maps,
                "also write each synthesized layer frame's synthesis error map into "
                "OUTPUT/qa/error/LAYER/ (emaki view's overlay)");
+  bool timings = false;
+  app.add_flag("--timings", timings,
+               "also print where the time went: wall and CPU seconds (all threads) of each stage, "
+               "named as the farm's tasks (prepare, passes, layers, composite, previews)");
   c.bind_previews(app);
   if (parse_cli(app, args)) return 0;
+  StageClock clock;
   const pipeline::Shot shot = shot::open(c.shot_path);
   shot::Request request = c.request("run");
   request.force = force;
   request.error_maps = error_maps;
+  if (timings) request.stages = &clock;
   const shot::RunResult r = shot::run(shot, request);
   end_progress_line();
+  if (timings) print_timings(clock);
   std::fprintf(stderr,
                "emaki run: frames %d-%d: %d layer-frames synthesized, %d already finished, %d "
                "frames composited; outputs in %s\n",

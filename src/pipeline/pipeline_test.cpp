@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <map>
 
 #include "core/error.h"
@@ -358,6 +359,63 @@ TEST(Pipeline, TemporalGuideChangesFramesAfterTheFirst) {
   };
   EXPECT_TRUE(same(0));  // the first frame has no temporal guide
   EXPECT_FALSE(same(2));
+}
+
+// Spins until this process has used `seconds` more CPU time.
+void burn_cpu(double seconds) {
+  const auto cpu = [] {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+  };
+  const double end = cpu() + seconds;
+  volatile double sink = 0.0;
+  while (cpu() < end)
+    for (int i = 0; i < 1000; ++i) sink = sink + 1.0;
+}
+
+// RunOptions::stages: a frame's passes, its compositing and outputs, and the rest go to their
+// stages (here passes and outputs that cost 20 and 10 ms of CPU each), and nothing changes.
+TEST(Pipeline, StageClockChargesEachStageAndChangesNoFrame) {
+  class SlowFrames : public SlidingFrames {
+   public:
+    using SlidingFrames::SlidingFrames;
+    Image<float> passes(int frame) const override {
+      burn_cpu(0.02);
+      return SlidingFrames::passes(frame);
+    }
+  };
+  class SlowStore : public MemoryStore {
+   public:
+    void write_frame(int f, ImageView<const float> c,
+                     const std::vector<ImageView<const float>>& layers,
+                     ImageView<const float> passes) override {
+      burn_cpu(0.01);
+      MemoryStore::write_frame(f, c, layers, passes);
+    }
+  };
+  const Shot shot = tiny_shot();
+  const SlowFrames frames(40, 30);
+  const auto ex = tiny_exemplar();
+  MemoryStore plain;
+  SlowStore timed;
+  run_shot(shot, frames, ex, CompositeInputs{}, plain, RunOptions{});
+  StageClock clock;
+  clock.enter(StageClock::kPreviews);  // what run_shot charges nothing to
+  RunOptions o;
+  o.stages = &clock;
+  const int calls = frames.calls;
+  const double prepare = clock.seconds(StageClock::kPrepare).cpu;
+  run_shot(shot, frames, ex, CompositeInputs{}, timed, o);
+  EXPECT_EQ(clock.seconds(StageClock::kPrepare).cpu, prepare);
+  EXPECT_EQ(clock.enter(StageClock::kPrepare), StageClock::kPreviews);  // handed back
+  const int read = frames.calls - calls;
+  EXPECT_GE(read, 4);
+  EXPECT_GE(clock.seconds(StageClock::kPasses).cpu, 0.02 * read);
+  EXPECT_GE(clock.seconds(StageClock::kComposite).cpu, 0.01 * 4);
+  EXPECT_GT(clock.seconds(StageClock::kLayers).cpu, 0.0);
+  for (int f = 0; f <= 3; ++f) EXPECT_TRUE(same_layer(plain, timed, f)) << f;
+  EXPECT_EQ(plain.frames, timed.frames);
 }
 
 // RunOptions::concurrent_layers: the layers that start no chain at a frame (every layer at the

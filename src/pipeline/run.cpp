@@ -290,6 +290,7 @@ class ShotRun {
     for (int f = start; f <= b_; ++f)
       for (const Layer* l : selected_) total_ += needs(*l, f) ? 1 : 0;
     t0_ = Clock::now();
+    const StageScope stage(o_.stages, StageClock::kLayers);
     held_.resize(prepared_.size());
     ink_pins_.assign(prepared_.size(), {});
     for (int f = start; f <= b_; ++f) {
@@ -352,8 +353,12 @@ class ShotRun {
 
   // Frame f's passes, read on first use: a frame whose layers are all finished needs none.
   const Image<float>& passes(int f) {
-    if (!passes_) passes_ = frames_.passes(f);
+    if (!passes_) passes_ = read_passes(f);
     return *passes_;
+  }
+  Image<float> read_passes(int f) const {
+    const StageScope stage(o_.stages, StageClock::kPasses);
+    return frames_.passes(f);
   }
 
   // Synthesizes the layers frame f still needs into `now` (parallel to prepared_); the others
@@ -361,7 +366,7 @@ class ShotRun {
   bool synthesize_frame(int f, std::vector<Held>& now) {
     bool changed = false;
     // The fields the farm's passes task made ahead are read only when a layer advects.
-    AdvectionFields fields([this, f] { return frames_.kept_fields(f); });
+    AdvectionFields fields([this, f] { return frames_.kept_fields(f); }, o_.stages);
     std::vector<std::optional<LayerFrame>> made = independent_layers(f);
     for (std::size_t i = 0; i < prepared_.size(); ++i) {
       const Layer& l = *prepared_[i].layer;
@@ -380,7 +385,7 @@ class ShotRun {
                              ? store_.read_field(l, f - 1, value_digest(held_[i].value.cview()))
                              : Image<int32_t>();
         }
-        if (prev_passes_.frame != f - 1) prev_passes_ = {f - 1, frames_.passes(f - 1), {}};
+        if (prev_passes_.frame != f - 1) prev_passes_ = {f - 1, read_passes(f - 1), {}};
         previous = &held_[i].value;
         previous_passes = &prev_passes_.value;
       }
@@ -419,7 +424,7 @@ class ShotRun {
   // a frame ink_reference_frame() names (the same in a resumed run or a farm chunk), with the
   // current frame f's passes or r's read.
   InkReference measured_ink(std::size_t i, int r, int f) {
-    const Image<float> other = r == f ? Image<float>() : frames_.passes(r);
+    const Image<float> other = r == f ? Image<float>() : read_passes(r);
     const ImageView<const float> p = r == f ? passes(f).cview() : other.cview();
     AdvectionFields none;
     RunOptions measured_only = o_;  // cancellable, but no error map: the result is only measured
@@ -474,6 +479,7 @@ class ShotRun {
   // Composites frame f from every layer of the shot: this frame's new values, else the stored
   // ones. A layer left out with --layers that was never synthesized leaves the frame alone.
   void composite(int f, const std::vector<Held>& now) {
+    const StageScope stage(o_.stages, StageClock::kComposite);
     std::vector<Image<float>> read_back;
     read_back.reserve(shot_.layers.size());  // views point into it: no reallocation
     std::vector<ImageView<const float>> views;
@@ -490,8 +496,9 @@ class ShotRun {
       }
     }
     tick(f, "");
-    const Image<float> comp = composite_frame(shot_, passes(f).cview(), views, ci_);
-    store_.write_frame(f, comp.cview(), views, passes(f).cview());
+    const ImageView<const float> p = passes(f).cview();
+    const Image<float> comp = composite_frame(shot_, p, views, ci_);
+    store_.write_frame(f, comp.cview(), views, p);
     ++report_.composited;
   }
 

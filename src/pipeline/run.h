@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/stage_clock.h"
 #include "pipeline/frames.h"
 #include "pipeline/shot_description.h"
 
@@ -92,6 +93,10 @@ struct RunOptions {
   // Polled during each synthesis (synth::Params::cancel): true stops the run with
   // synth::Cancelled, leaving the layer frames written before it; false changes nothing.
   std::function<bool()> cancel;
+  // When set, charged the run's work by stage (core/stage_clock.h): run_shot charges its frames'
+  // passes (and their advection fields) to kPasses, compositing and the frames' outputs to
+  // kComposite, the rest to kLayers. Changes no result.
+  StageClock* stages = nullptr;
 };
 
 struct RunReport {

@@ -62,12 +62,13 @@ void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>&
   params.uniformity_map = synth::Plane(map.cview());
 }
 
-AdvectionFields::AdvectionFields(std::function<std::vector<KeptField>()> kept)
-    : kept_(std::move(kept)) {}
+AdvectionFields::AdvectionFields(std::function<std::vector<KeptField>()> kept, StageClock* clock)
+    : kept_(std::move(kept)), clock_(clock) {}
 
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
   if (const temporal::AdvectionField* f = find(l, frame)) return *f;
+  const StageScope stage(clock_, StageClock::kPasses);
   if (kept_) {
     for (KeptField& k : kept_()) entries_.push_back(std::make_unique<KeptField>(std::move(k)));
     kept_ = nullptr;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/stage_clock.h"
 #include "pipeline/frames.h"
 #include "pipeline/shot_description.h"
 #include "synth/synthesizer.h"
@@ -52,8 +53,11 @@ void temporal_uniformity(const TemporalSpec& t, const std::vector<Image<float>>&
 class AdvectionFields {
  public:
   // `kept`, when given, is asked once, before the first field is computed, for the fields made
-  // ahead (FrameSource::kept_fields): a field found there is not computed again.
-  explicit AdvectionFields(std::function<std::vector<KeptField>()> kept = {});
+  // ahead (FrameSource::kept_fields): a field found there is not computed again. `clock`, when
+  // given, is charged the fields' reading and computing as StageClock::kPasses (the farm's passes
+  // task makes them).
+  explicit AdvectionFields(std::function<std::vector<KeptField>()> kept = {},
+                           StageClock* clock = nullptr);
   const temporal::AdvectionField& get(const Layer& layer, int frame,
                                       const std::function<temporal::AdvectionField()>& compute);
   // The field get() gave `layer` at `frame`, or null when it has not been computed.
@@ -75,6 +79,7 @@ class AdvectionFields {
   const Image<float>& cut(ImageView<const float> passes, int what);
   std::vector<std::unique_ptr<Cut>> cuts_;  // stable addresses
   std::function<std::vector<KeptField>()> kept_;
+  StageClock* clock_;
   std::vector<std::unique_ptr<KeptField>> entries_;  // stable addresses
 };
 

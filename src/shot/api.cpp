@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
+#include "core/stage_clock.h"
 #include "pipeline/temporal_guide.h"
 #include "shot/input_cache.h"
 #include "shot/inputs.h"
@@ -92,6 +93,7 @@ namespace {
 RunResult run_with(const pipeline::Shot& shot, const Request& request, InputCache* cache) {
   pipeline::check_run_options(shot, run_options(request));
   const Scope scope(shot, request);
+  const StageScope stage(request.stages, StageClock::kPrepare);
   // Everything that can fail on the inputs fails here, before a single output file exists.
   std::vector<std::string> rendered;
   const auto exemplars = load_exemplars_checked(
@@ -107,6 +109,7 @@ RunResult run_with(const pipeline::Shot& shot, const Request& request, InputCach
   io::FileStore store(shot, io::StoreMode::kRun, access(request));  // locked until the end
   keep_references(shot, exemplars, rendered);
   out.report = pipeline::run_shot(shot, *frames, exemplars, ci, store, run_options(request), maps);
+  const StageScope previews_stage(request.stages, StageClock::kPreviews);
   out.previews = previews(shot, request);
   return out;
 }
