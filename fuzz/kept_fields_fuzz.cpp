@@ -9,23 +9,19 @@
 #include <cstring>
 #include <vector>
 
-#include "core/fnv.h"
 #include "store/kept_fields.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<uint8_t> bytes(data, data + size);
   int32_t frame = 7, width = 16, height = 12;
-  constexpr std::size_t kHeader = 40, kDigestAt = 32;
+  constexpr std::size_t kHeader = 40;
   if (size >= kHeader) {
     int32_t f = 0, w = 0, h = 0;
     std::memcpy(&f, data + 12, 4);
     std::memcpy(&w, data + 16, 4);
     std::memcpy(&h, data + 20, 4);
     if (w > 0 && w <= 64 && h > 0 && h <= 64) frame = f, width = w, height = h;
-    emaki::FnvLanes lanes;  // the file's digest (kept_fields.cpp)
-    lanes.add(data + kHeader, size - kHeader);
-    const uint64_t digest = lanes.value();
-    std::memcpy(bytes.data() + kDigestAt, &digest, 8);
+    emaki::io::seal_kept_fields(bytes.data(), bytes.size());
   }
   const std::vector<emaki::pipeline::KeptField> fields =
       emaki::io::decode_kept_fields(bytes.data(), bytes.size(), frame, width, height);

@@ -143,6 +143,15 @@ std::string encode_kept_fields(int frame, int width, int height,
   return out;
 }
 
+void seal_kept_fields(void* bytes, std::size_t size) {
+  FileHeader h;
+  CHECK_GE(size, sizeof h);
+  auto* b = static_cast<unsigned char*>(bytes);
+  std::memcpy(&h, b, sizeof h);
+  h.digest = digest(b + sizeof h, size - sizeof h);
+  std::memcpy(b, &h, sizeof h);
+}
+
 std::vector<pipeline::KeptField> decode_kept_fields(const void* bytes, std::size_t size, int frame,
                                                     int width, int height) {
   const auto* b = static_cast<const unsigned char*>(bytes);

@@ -27,4 +27,9 @@ std::string encode_kept_fields(int frame, int width, int height,
 std::vector<pipeline::KeptField> decode_kept_fields(const void* bytes, std::size_t size, int frame,
                                                     int width, int height);
 
+// Sets the digest in the header of `bytes` (size >= the 40-byte header) to that of the bytes
+// after it, as encode_kept_fields does: for files made by hand (the fuzz target's mutations,
+// which then reach the fields' own checks).
+void seal_kept_fields(void* bytes, std::size_t size);
+
 }  // namespace emaki::io

@@ -111,6 +111,16 @@ TEST(KeptFields, AChangedByteGivesNone) {
   }
 }
 
+TEST(KeptFields, SealingWritesTheDigestEncodingWrites) {
+  const std::string bytes = encode_kept_fields(0, 13, 7, just(with_surfaces(field(13, 7, 1))));
+  std::string b = bytes;
+  for (std::size_t at = 32; at < 40; ++at) b[at] = char(b[at] ^ 0x5a);  // the digest
+  EXPECT_TRUE(decode_kept_fields(b.data(), b.size(), 0, 13, 7).empty());
+  seal_kept_fields(b.data(), b.size());
+  EXPECT_EQ(b, bytes);
+  EXPECT_EQ(decode_kept_fields(b.data(), b.size(), 0, 13, 7).size(), 1u);
+}
+
 // A file whose digest matches but whose entries leave the frame, or whose errors or shares are
 // not finite, is not a field emaki made: nothing is taken from it.
 TEST(KeptFields, EntriesOutsideTheFrameOrNonFiniteErrorsGiveNone) {
