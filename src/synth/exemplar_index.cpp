@@ -163,6 +163,7 @@ CoherenceSets build_coherence_sets(const Image<int16_t>& src, int patch_size, in
                                    const CoherenceSets* coarser, PatchSsdFn ssd, uint64_t seed) {
   CHECK(patch_size % 2 == 1);
   CHECK(k >= 1 && k <= kMaxIndexK);
+  CHECK_EQ(src.channels() % 2, 0);  // the kernels read whole int16 pairs
   const int sw = src.width(), sh = src.height();
   const Builder b{src,
                   patch_size,

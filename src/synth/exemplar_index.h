@@ -45,7 +45,8 @@ inline int index_exclusion(int patch_size) {
   return patch_size / 2;
 }
 
-// One level's sets. `coarser`: the next coarser level's sets (its half size), or nullptr.
+// One level's sets over the level's features (an even channel count, as FeatureLayout pads
+// them). `coarser`: the next coarser level's sets (its half size), or nullptr.
 CoherenceSets build_coherence_sets(const Image<int16_t>& src, int patch_size, int k,
                                    const CoherenceSets* coarser, PatchSsdFn ssd, uint64_t seed);
 

@@ -10,7 +10,9 @@
 namespace emaki::synth {
 
 // a, b: top-left element of each patch; strides in elements between rows; each patch row is
-// `row_elems` contiguous int16 (patch width x channels, a multiple of 8); `rows` rows.
+// `row_elems` contiguous int16 (patch width x channels, an even count: FeatureLayout pads pixels
+// to whole int16 pairs); `rows` rows. Nothing past a row's last element is read, so a row may end
+// where its memory does.
 // Stops after any row once the running sum exceeds `bound` and returns that partial sum
 // (which is then > bound).
 using PatchSsdFn = int64_t (*)(const int16_t* a, std::ptrdiff_t a_stride, const int16_t* b,

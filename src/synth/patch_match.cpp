@@ -424,6 +424,7 @@ void occupancy_window_sums(const PatchMatchLevel& L, int p, std::vector<int32_t>
 }
 
 void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
+  CHECK_EQ(L.src->channels() % 2, 0);  // the kernels read whole int16 pairs
   const int r = C.patch_size / 2;
   const int row_elems = C.patch_size * L.src->channels();
   parallel_rows(L.th, 16, [&](int y0, int y1) {
@@ -446,6 +447,7 @@ void compute_errors(const PatchMatchLevel& L, const PatchMatchConfig& C) {
 void run_patch_match(const PatchMatchLevel& L, const PatchMatchConfig& C) {
   CHECK(C.ssd != nullptr);
   CHECK_EQ(C.patch_size % 2, 1);
+  CHECK_EQ(L.src->channels() % 2, 0);
   if (C.coherence) CHECK(C.coherence->width == L.sw && C.coherence->height == L.sh);
   const int p = C.patch_size;
   int64_t active_count = 0;

@@ -42,7 +42,7 @@ inline int band_rows(int height) {
 struct PatchMatchLevel {
   int sw = 0, sh = 0, tw = 0, th = 0;
   int border = 0;                          // padding of tgt
-  const Image<int16_t>* src = nullptr;     // sw x sh features
+  const Image<int16_t>* src = nullptr;     // sw x sh features (an even channel count)
   const Image<int16_t>* tgt = nullptr;     // (tw + 2 border) x (th + 2 border) features
   const Image<uint8_t>* active = nullptr;  // tw x th, or empty: all active
   Image<int32_t>* nnf = nullptr;           // tw x th x 2

@@ -38,7 +38,7 @@ FeatureLayout make_layout(const Inputs& in, const Params& p) {
   L.style_channels = plane_channels(in.style);
   for (const auto& g : in.guides) L.guide_channels += plane_channels(g.source);
   const int n = L.style_channels + L.guide_channels;
-  L.channels = (n + 7) / 8 * 8;
+  L.channels = padded_channels(n);
   std::vector<float> w;
   std::vector<std::pair<float, float>> range;
   // Each channel's range, [0, 1] unless the values leave it: every plane's channels in one pass.

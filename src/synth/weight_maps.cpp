@@ -58,8 +58,8 @@ void check_weight_maps(const Inputs& in, const Params& p, int tw, int th) {
     throw Error("guides", fmt::format("at most {} guides may have a weight map (got {})",
                                       kMaxWeightMaps, maps));
   // A group's weighted sum is at most p^2 x channels x 16383^2 x 2^16: below 2^63 while
-  // p^2 x channels <= 2^19.
-  const int padded = (channels + 7) / 8 * 8;
+  // p^2 x channels <= 2^19, channels counted as the kernels read them (padded to an even count).
+  const int padded = padded_channels(channels);
   if (int64_t(p.patch_size) * p.patch_size * padded > (int64_t(1) << 19))
     throw Error("patch size",
                 fmt::format("{}x{} patches over {} channels are too large with weight maps "
