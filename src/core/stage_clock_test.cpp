@@ -41,6 +41,7 @@ TEST(StageClock, ChargesTheInnermostStageAndRestoresTheOuter) {
     burn(0.02);
   }
   EXPECT_EQ(clock.enter(StageClock::kPrepare), StageClock::kPrepare);
+  const double sum = cpu_sum(clock);  // up to its own reading of the clock, before the next
   const double total = process_cpu() - start;
   EXPECT_GE(clock.seconds(StageClock::kPasses).cpu, 0.05);
   EXPECT_GE(clock.seconds(StageClock::kLayers).cpu, 0.02);
@@ -48,8 +49,8 @@ TEST(StageClock, ChargesTheInnermostStageAndRestoresTheOuter) {
   EXPECT_EQ(clock.seconds(StageClock::kComposite).cpu, 0.0);
   EXPECT_EQ(clock.seconds(StageClock::kComposite).wall, 0.0);
   // Every moment is charged to exactly one stage.
-  EXPECT_LE(cpu_sum(clock), total);
-  EXPECT_GE(cpu_sum(clock), 0.07);
+  EXPECT_LE(sum, total);
+  EXPECT_GE(sum, 0.07);
   EXPECT_GE(clock.seconds(StageClock::kPasses).wall, 0.0);
 }
 
