@@ -148,26 +148,13 @@ int64_t patch_ssd_avx2(const int16_t* a, std::ptrdiff_t a_stride, const int16_t*
   }
   // Other widths up to 127: the whole vectors known at compile time (5x5 patches of up to 24
   // channels, 7x7 of up to 18), the tail's length not.
-  switch (row_elems / 16) {
-    case 0:
-      return ssd_vectors<0>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 1:
-      return ssd_vectors<1>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 2:
-      return ssd_vectors<2>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 3:
-      return ssd_vectors<3>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 4:
-      return ssd_vectors<4>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 5:
-      return ssd_vectors<5>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 6:
-      return ssd_vectors<6>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    case 7:
-      return ssd_vectors<7>(a, a_stride, b, b_stride, row_elems, rows, bound);
-    default:
-      return ssd_vectors<-1>(a, a_stride, b, b_stride, row_elems, rows, bound);
-  }
+  using Fn = int64_t (*)(const int16_t*, std::ptrdiff_t, const int16_t*, std::ptrdiff_t, int, int,
+                         int64_t);
+  static constexpr Fn kByVectors[8] = {ssd_vectors<0>, ssd_vectors<1>, ssd_vectors<2>,
+                                       ssd_vectors<3>, ssd_vectors<4>, ssd_vectors<5>,
+                                       ssd_vectors<6>, ssd_vectors<7>};
+  const Fn f = row_elems / 16 < 8 ? kByVectors[row_elems / 16] : ssd_vectors<-1>;
+  return f(a, a_stride, b, b_stride, row_elems, rows, bound);
 }
 
 namespace {
