@@ -166,6 +166,13 @@ TEST_F(OutputSafety, HiddenUserFilesInTheOutputFolderSurvive) {
   // ... also beside the QA maps (qa/KIND/LAYER/), but not in a linked folder there.
   fs::create_directories(dir_ / "qa/error/base");
   write_text(dir_ / "qa/error/base/.frame_0000.emaki-tmp-0123456789abcdef.png", "left over\n");
+  // ... and beside the farm's pass cache and the exemplars' reference passes.
+  for (const char* left : {"passes/.frame_0000.emaki-tmp-0123456789abcdef.passes",
+                           "passes/.advection_0001.emaki-tmp-0123456789abcdef.field",
+                           "references/.0123456789abcdef.emaki-tmp-0123456789abcdef.passes"}) {
+    fs::create_directories((dir_ / left).parent_path());
+    write_text(dir_ / left, "left over\n");
+  }
   fs::create_directories(dir_ / "elsewhere");
   write_text(dir_ / "elsewhere/.frame_0000.emaki-tmp-0123456789abcdef.png", "not here\n");
   fs::create_directory_symlink(dir_ / "elsewhere", dir_ / "qa/error/linked");
@@ -182,6 +189,8 @@ TEST_F(OutputSafety, HiddenUserFilesInTheOutputFolderSurvive) {
   EXPECT_FALSE(fs::exists(dir_ / "composite/.frame_0000.emaki-tmp-0123456789abcdef.png"));
   EXPECT_FALSE(fs::exists(dir_ / "qa/error/base/.frame_0000.emaki-tmp-0123456789abcdef.png"));
   EXPECT_TRUE(fs::exists(dir_ / "elsewhere/.frame_0000.emaki-tmp-0123456789abcdef.png"));
+  EXPECT_TRUE(fs::is_empty(dir_ / "passes"));
+  EXPECT_FALSE(fs::exists(dir_ / "references/.0123456789abcdef.emaki-tmp-0123456789abcdef.passes"));
   EXPECT_TRUE(fs::is_symlink(dir_ / "composite/.frame_0001.emaki-tmp-fedcba9876543210.png"));
   EXPECT_EQ(slurp(dir_ / "victim.txt"), "precious\n");
   EXPECT_TRUE(fs::is_regular_file(dir_ / "composite/frame_0001.png"));

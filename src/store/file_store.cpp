@@ -158,7 +158,8 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
                                    l.name + "_", {".png", ".exr"});
     frames_ = manifested((root / "composite").string(), frames_manifest(shot), "frame_",
                          {".png", ".exr"});
-    passes_ = manifested((root / "passes").string(), passes_manifest(shot), "frame_", {".exr"});
+    passes_ = manifested((root / "passes").string(), passes_manifest(shot), "frame_",
+                         {".passes", ".exr"});
     return;
   }
   make_folder(root);
@@ -193,14 +194,15 @@ FileStore::FileStore(const Shot& shot, StoreMode mode, StoreAccess access)
   std::error_code ec;
   if (fs::is_directory(cache, ec)) {
     clean_up(cache, [](const std::string& t) {
-      return t == kManifest || is_frame_name(t, "frame_", {".exr"}) ||
+      return t == kManifest || is_frame_name(t, "frame_", {".passes", ".exr"}) ||
              is_frame_name(t, "advection_", {".field"});
     });
   }
-  passes_ = manifested(cache.string(), passes_manifest(shot), "frame_", {".exr"});
+  passes_ = manifested(cache.string(), passes_manifest(shot), "frame_", {".passes", ".exr"});
   if (const fs::path refs = root / "references"; fs::is_directory(refs, ec))
-    clean_up(refs,
-             [](const std::string& t) { return t.ends_with(".exr") || t.ends_with(".digest"); });
+    clean_up(refs, [](const std::string& t) {
+      return t.ends_with(".passes") || t.ends_with(".exr") || t.ends_with(".digest");
+    });
   // QA maps (store/qa_maps.h): qa/KIND/LAYER/frame_NNNN.png, in folders (never links) only.
   const auto folders = [](const fs::path& dir) {
     std::vector<fs::path> out;
