@@ -131,25 +131,33 @@ int rows_per_chunk(int compression) {
 }
 
 // OpenEXR's ZIP filter on a chunk's bytes: even and odd bytes split into halves, then each byte
-// as the difference from the one before (zlib then finds more repeats).
+// as the difference from the one before (zlib then finds more repeats). Both steps in one pass,
+// each half a loop of its own that the compiler vectorizes (as one loop, byte by byte, this
+// was a fifth of a composite task's instructions).
 void zip_filter(const unsigned char* raw, std::size_t n, unsigned char* out) {
+  if (n == 0) return;
+  const std::size_t even = (n + 1) / 2, odd = n / 2;
   unsigned char* t1 = out;
-  unsigned char* t2 = out + (n + 1) / 2;
-  for (std::size_t i = 0; i < n; ++i) *((i & 1) ? t2++ : t1++) = raw[i];
-  int p = n > 0 ? out[0] : 0;
-  for (std::size_t i = 1; i < n; ++i) {
-    const int d = int(out[i]) - p + (128 + 256);
-    p = out[i];
-    out[i] = static_cast<unsigned char>(d);
-  }
+  unsigned char* t2 = out + even;
+  t1[0] = raw[0];
+  for (std::size_t j = 1; j < even; ++j)
+    t1[j] = static_cast<unsigned char>(raw[2 * j] - raw[2 * j - 2] + 128);
+  if (odd == 0) return;
+  t2[0] = static_cast<unsigned char>(raw[1] - raw[2 * (even - 1)] + 128);
+  for (std::size_t j = 1; j < odd; ++j)
+    t2[j] = static_cast<unsigned char>(raw[2 * j + 1] - raw[2 * j - 1] + 128);
 }
 
-void zip_unfilter(unsigned char* filtered, std::size_t n, unsigned char* raw) {
-  for (std::size_t i = 1; i < n; ++i)
-    filtered[i] = static_cast<unsigned char>(int(filtered[i - 1]) + int(filtered[i]) - 128);
-  const unsigned char* t1 = filtered;
-  const unsigned char* t2 = filtered + (n + 1) / 2;
-  for (std::size_t i = 0; i < n; ++i) raw[i] = (i & 1) ? *t2++ : *t1++;
+// zip_filter undone: the running sum of the differences, each byte written to its place.
+void zip_unfilter(const unsigned char* filtered, std::size_t n, unsigned char* raw) {
+  if (n == 0) return;
+  const std::size_t even = (n + 1) / 2;
+  unsigned char acc = filtered[0];
+  raw[0] = acc;
+  for (std::size_t j = 1; j < even; ++j)
+    raw[2 * j] = acc = static_cast<unsigned char>(acc + filtered[j] - 128);
+  for (std::size_t j = 0; j < n / 2; ++j)
+    raw[2 * j + 1] = acc = static_cast<unsigned char>(acc + filtered[even + j] - 128);
 }
 
 // The channels emaki's layer files hold, in the order OpenImageIO gives them: a whole-file read
