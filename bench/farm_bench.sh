@@ -90,6 +90,12 @@ measure_run() {
       sub(/^layers$/, "layer", $3); print $3, $4, $5 }' "$work/stderr")
   done
 }
+# The tasks run as the farm's batch scripts run them (src/farm/slurm.cpp): glibc's huge-page
+# tunable named, so that no task starts itself again to add it.
+case ":${GLIBC_TUNABLES-}:" in
+  *:glibc.malloc.hugetlb=*) task_tunables=$GLIBC_TUNABLES ;;
+  *) task_tunables=${GLIBC_TUNABLES:+$GLIBC_TUNABLES:}glibc.malloc.hugetlb=1 ;;
+esac
 # measure_tasks DIR: the plan's tasks into DIR, stage by stage; adds to stage_wall, stage_cpu.
 measure_tasks() {
   local dir=$1 kind line w c  # `set --` below takes the positional parameters
@@ -100,7 +106,7 @@ measure_tasks() {
     stage_n[$kind]=0
     while IFS= read -r -d '' line; do
       eval "set -- $line"
-      read -r w c < <(timed "$@")
+      read -r w c < <(GLIBC_TUNABLES=$task_tunables timed "$@")
       stage_wall[$kind]=$(calc "${stage_wall[$kind]} + $w")
       stage_cpu[$kind]=$(calc "${stage_cpu[$kind]} + $c")
       stage_n[$kind]=$((stage_n[$kind] + 1))

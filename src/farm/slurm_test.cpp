@@ -213,6 +213,31 @@ TEST_F(SlurmTest, TheJobScriptDoesNotFollowPlantedSymlinks) {
   EXPECT_NE(test::file_bytes(farm + "/logs/" + t.id + ".log").find("[prepare]"), std::string::npos);
 }
 
+// Each task starts once: the script names glibc's huge-page tunable, which emaki would otherwise
+// start itself again to add; a setting the submitting environment makes stays as it is.
+TEST_F(SlurmTest, TheJobScriptNamesTheHugePageTunableUnlessTheUserDid) {
+  const shot::Plan p = plan_of("a.toml", (dir_ / "out").string());
+  const shot::Task& t = p.tasks.front();
+  const std::string farm = p.shots[0].shot.outputs.folder + "/farm";
+  for (const char* sub : {"/status", "/logs"}) fs::create_directories(farm + sub);
+  const fs::path script = dir_ / "prepare.sh";
+  write_file(script, batch_script(p, {&t}, {}, {}));
+  write_file(dir_ / "bin/emaki", "#!/bin/sh\nprintf '%s' \"$GLIBC_TUNABLES\"\n", true);
+  for (const auto& [given, seen] : std::vector<std::pair<std::string, std::string>>{
+           {"", "glibc.malloc.hugetlb=1"},
+           {"glibc.malloc.tcache_count=0", "glibc.malloc.tcache_count=0:glibc.malloc.hugetlb=1"},
+           {"glibc.malloc.hugetlb=0", "glibc.malloc.hugetlb=0"},
+           {"glibc.malloc.check=0:glibc.malloc.hugetlb=2",
+            "glibc.malloc.check=0:glibc.malloc.hugetlb=2"}}) {
+    const std::string env =
+        given.empty() ? "unset GLIBC_TUNABLES; " : "GLIBC_TUNABLES='" + given + "' ";
+    const std::string run =
+        "cd '" + farm + "' && " + env + "SLURM_ARRAY_TASK_ID=0 sh '" + script.string() + "'";
+    EXPECT_EQ(std::system(run.c_str()), 0);
+    EXPECT_EQ(test::file_bytes(farm + "/logs/" + t.id + ".log"), seen) << given;
+  }
+}
+
 // A jobs.tsv copied from another shot (or stale) names jobs that are not this shot's: squeue is
 // asked for the user's jobs only, and only jobs under the shot's own job names count or are
 // cancelled.
