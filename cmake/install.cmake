@@ -108,6 +108,6 @@ set(CPACK_DEBIAN_DEV_PACKAGE_NAME emaki-dev)
 set(CPACK_DEBIAN_DEV_DESCRIPTION
     "stylize 3D animation by example - C++ development files\n emaki's engine and shot API as CMake targets: find_package(emaki CONFIG), emaki::synth, emaki::shot.")
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
-    "emaki (= ${PROJECT_VERSION}), libtbb-dev, libglm-dev, libfmt-dev, libpng-dev, zlib1g-dev, libtinygltf-dev, libtomlplusplus-dev, libopencolorio-dev, pkg-config")
+    "emaki (= ${PROJECT_VERSION}), libtbb-dev, libglm-dev, libfmt-dev, libpng-dev, zlib1g-dev, libdeflate-dev, libtinygltf-dev, libtomlplusplus-dev, libopencolorio-dev, pkg-config")
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 include(CPack)

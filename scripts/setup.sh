@@ -6,7 +6,7 @@
 set -e
 PKGS="build-essential cmake pkg-config libopenimageio-dev openimageio-tools libopencv-core-dev
 libopenexr-dev libtinygltf-dev libtbb-dev libcli11-dev libtomlplusplus-dev libfmt-dev
-libglm-dev libopencolorio-dev opencolorio-tools python3-pyopencolorio libgtest-dev libgmock-dev libpng-dev zlib1g-dev ffmpeg blender python3-numpy
+libglm-dev libopencolorio-dev opencolorio-tools python3-pyopencolorio libgtest-dev libgmock-dev libpng-dev zlib1g-dev libdeflate-dev ffmpeg blender python3-numpy
 pybind11-dev python3-dev python3-pytest
 clang-14 libclang-rt-14-dev clang-format slurm-wlm slurm-client munge
 libcpp-httplib-dev chromium"

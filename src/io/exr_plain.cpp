@@ -1,8 +1,8 @@
 #include "io/exr_plain.h"
 
+#include <libdeflate.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <atomic>
@@ -28,8 +28,23 @@ constexpr uint32_t kNotScanlinePart = 0x200 | 0x800 | 0x1000;  // tiled, deep, m
 constexpr int32_t kHalf = 1, kFloat = 2;                       // channel pixel types
 // Compressions: none, ZIPS (one row a chunk) and ZIP (16 rows a chunk).
 constexpr int kNone = 0, kZips = 2, kZip = 3;
-// OpenEXR's own default zlib level for ZIP.
+// OpenEXR's own default zlib level for ZIP. The zlib streams are libdeflate's: at this level 1.7x
+// as fast as zlib's to write and 2-3x to read on emaki's layers, and a little smaller.
 constexpr int kZipLevel = 4;
+
+// This thread's libdeflate (de)compressor, made on first use: they hold tables of a few hundred
+// KB that are not to be made again for every chunk, and may not be shared between threads.
+libdeflate_compressor* thread_compressor() {
+  thread_local std::unique_ptr<libdeflate_compressor, void (*)(libdeflate_compressor*)> c(
+      libdeflate_alloc_compressor(kZipLevel), &libdeflate_free_compressor);
+  return c.get();
+}
+
+libdeflate_decompressor* thread_decompressor() {
+  thread_local std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> d(
+      libdeflate_alloc_decompressor(), &libdeflate_free_decompressor);
+  return d.get();
+}
 
 struct Channel {
   std::string name;
@@ -271,8 +286,9 @@ bool read_chunks(int fd, uint64_t file_size, const Layout& l, Image<float>& out)
     if (!read_at(fd, offset + 8, chunk.data(), chunk.size())) return false;
     const unsigned char* data = chunk.data();
     if (std::size_t(bytes) < expect) {
-      uLongf got = uLongf(expect);
-      if (::uncompress(filtered.data(), &got, chunk.data(), uLong(bytes)) != Z_OK || got != expect)
+      libdeflate_decompressor* d = thread_decompressor();
+      if (!d || libdeflate_zlib_decompress(d, chunk.data(), std::size_t(bytes), filtered.data(),
+                                           expect, nullptr) != LIBDEFLATE_SUCCESS)
         return false;
       zip_unfilter(filtered.data(), expect, raw.data());
       data = raw.data();
@@ -368,17 +384,17 @@ void pack_rows(ImageView<const float> image, int first, int rows, const std::vec
 // the filtered rows and the deflated bytes.
 struct ChunkScratch {
   ChunkScratch(std::size_t most, bool zip)
-      : bound(zip ? ::compressBound(uLong(most)) : 0),
+      : bound(zip ? libdeflate_zlib_compress_bound(nullptr, most) : 0),
         raw(std::make_unique_for_overwrite<unsigned char[]>(most)),
         filtered(std::make_unique_for_overwrite<unsigned char[]>(zip ? most : 0)),
         packed(std::make_unique_for_overwrite<unsigned char[]>(bound)) {}
-  uLong bound;
+  std::size_t bound;
   std::unique_ptr<unsigned char[]> raw, filtered, packed;
 };
 
 // Rows [first, first + rows) of `image` as a chunk, into `piece`: its first y, its byte count and
 // its rows, ZIP-filtered and deflated (when `s` is a ZIP scratch) unless that comes out no
-// smaller. False when zlib fails.
+// smaller. False when the compressor cannot be made (out of memory).
 bool encode_chunk(ImageView<const float> image, int first, int rows, const std::vector<int>& order,
                   bool half, std::size_t row_bytes, ChunkScratch& s, std::string& piece) {
   const std::size_t n = row_bytes * std::size_t(rows);
@@ -387,9 +403,10 @@ bool encode_chunk(ImageView<const float> image, int first, int rows, const std::
   std::size_t size = n;
   if (s.bound > 0) {
     zip_filter(s.raw.get(), n, s.filtered.get());
-    uLongf got = uLongf(s.bound);
-    if (::compress2(s.packed.get(), &got, s.filtered.get(), uLong(n), kZipLevel) != Z_OK)
-      return false;
+    libdeflate_compressor* c = thread_compressor();
+    const std::size_t got =
+        c ? libdeflate_zlib_compress(c, s.filtered.get(), n, s.packed.get(), s.bound) : 0;
+    if (got == 0) return false;
     if (got < n) data = s.packed.get(), size = got;
   }
   const int32_t prefix[2] = {first, int32_t(size)};
