@@ -90,6 +90,16 @@ class SlurmTest : public ::testing::Test {
     return shot::plan(std::vector<shot::PlannedShot>{{"", path, shot::open(path)}}, o);
   }
 
+  // The batch script of the plan's first task, at DIR/prepare.sh, with its farm folder's status/
+  // and logs/ made, as submit makes them.
+  fs::path first_task_script(const shot::Plan& p) const {
+    const std::string farm = p.shots[0].shot.outputs.folder + "/farm";
+    for (const char* sub : {"/status", "/logs"}) fs::create_directories(farm + sub);
+    const fs::path script = dir_ / "prepare.sh";
+    write_file(script, batch_script(p, {&p.tasks.front()}, {}, {}));
+    return script;
+  }
+
   fs::path dir_;
   std::string old_path_;
 };
@@ -193,9 +203,7 @@ TEST_F(SlurmTest, TheJobScriptDoesNotFollowPlantedSymlinks) {
   const shot::Plan p = plan_of("a.toml", (dir_ / "out").string());
   const shot::Task& t = p.tasks.front();
   const std::string farm = p.shots[0].shot.outputs.folder + "/farm";
-  for (const char* sub : {"/status", "/logs"}) fs::create_directories(farm + sub);
-  const fs::path script = dir_ / "prepare.sh";
-  write_file(script, batch_script(p, {&t}, {}, {}));
+  const fs::path script = first_task_script(p);
   std::vector<fs::path> victims;
   for (const std::string& record :
        {"/status/" + t.id + ".start", "/status/" + t.id + ".end", "/status/" + t.id + ".exit",
@@ -219,9 +227,7 @@ TEST_F(SlurmTest, TheJobScriptNamesTheHugePageTunableUnlessTheUserDid) {
   const shot::Plan p = plan_of("a.toml", (dir_ / "out").string());
   const shot::Task& t = p.tasks.front();
   const std::string farm = p.shots[0].shot.outputs.folder + "/farm";
-  for (const char* sub : {"/status", "/logs"}) fs::create_directories(farm + sub);
-  const fs::path script = dir_ / "prepare.sh";
-  write_file(script, batch_script(p, {&t}, {}, {}));
+  const fs::path script = first_task_script(p);
   write_file(dir_ / "bin/emaki", "#!/bin/sh\nprintf '%s' \"$GLIBC_TUNABLES\"\n", true);
   for (const auto& [given, seen] : std::vector<std::pair<std::string, std::string>>{
            {"", "glibc.malloc.hugetlb=1"},
