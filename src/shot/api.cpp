@@ -17,7 +17,6 @@
 #include "shot/parser.h"
 #include "shot/plan.h"
 #include "store/file_store.h"
-#include "store/mapped_passes.h"
 #include "store/previews.h"
 #include "store/qa_maps.h"
 
@@ -171,8 +170,8 @@ int render_passes(const pipeline::Shot& shot, const Request& request) {
   const int a = request.first_frame < 0 ? shot.source.first_frame : request.first_frame;
   const int b = request.last_frame < 0 ? shot.source.last_frame : request.last_frame;
   // Each frame's advection fields are made here, once, for every temporal layer task to read
-  // (they would otherwise each compute them): from the frame before, mapped from the cache or
-  // rendered for the chunk's first frame.
+  // (they would otherwise each compute them): from the frame before, read or rendered for the
+  // chunk's first frame.
   const bool advects = std::any_of(shot.layers.begin(), shot.layers.end(),
                                    [](const pipeline::Layer& l) { return l.temporal.enabled; });
   std::optional<Image<float>> previous;
@@ -184,10 +183,6 @@ int render_passes(const pipeline::Shot& shot, const Request& request) {
     }
     Image<float> passes = frames->passes(f);
     if (advects && f > shot.source.first_frame) {
-      // The frame before, from the cache when an earlier chunk's task has written it.
-      if (!previous && store.has_passes(f - 1))
-        previous =
-            io::map_passes(store.paths().passes_file(f - 1), shot.source.width, shot.source.height);
       if (!previous) previous = frames->passes(f - 1);
       std::vector<pipeline::KeptField> fields =
           pipeline::advection_fields(shot, previous->cview(), passes.cview(), f);
