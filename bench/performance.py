@@ -211,31 +211,47 @@ def section_shot(a, build):
     # 17 frames: two of the temporal frames re-measure the ink layers' reference (every 8 frames,
     # docs/design/ink-ratio.md), as often as along a whole shot.
     sizes = [("960x540", 17)] + ([("1920x1080", 9)] if a.full else [])
+    modes = [("layers at once (`emaki run`)", []),
+             ("one layer at a time", ["--one-layer-at-a-time"])]
     lines = ["## A shot in memory", "",
              "The bundled shot (three layers, temporal on) without files: rendering, synthesis, "
-             f"advection and compositing; {runs_text(a.runs)}:", "", "```sh"]
+             "advection and compositing, with the frame's layers synthesized at once (as `emaki "
+             "run` does) and one after another (`--one-layer-at-a-time`), the two alternated; "
+             f"{runs_text(a.runs)}:", "", "```sh"]
     rows = []
     for size, frames in sizes:
-        cmd = [os.path.join(build, "bench", "shot_bench"), size, str(frames)]
-        lines.append(shown(cmd))
-        outs = [run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON})["out"] for _ in range(a.runs)]
-        f0 = statistics.median(float(re.search(r"\(no temporal\) ([0-9.]+) s", o).group(1))
-                               for o in outs)
-        ft = statistics.median(float(re.search(r"\(temporal\) ([0-9.]+) s", o).group(1))
-                               for o in outs)
-        steps = {}
-        for o in outs:
-            for name, s in re.findall(r" (\w+) ([0-9.]+) s", o.split("per temporal frame:")[1]):
-                steps.setdefault(name, []).append(float(s))
-        split = ", ".join(f"{n} {statistics.median(v):.2f}" for n, v in steps.items())
-        rows.append(f"| {size} | {f0:.2f} | {ft:.2f} | {split} |")
-        TEMPORAL_FRAME[size] = ft
+        cmds = [[os.path.join(build, "bench", "shot_bench")] + flags + [size, str(frames)]
+                for _, flags in modes]
+        lines += [shown(c) for c in cmds]
+        runs = [[], []]
+        for _ in range(a.runs):
+            for k, cmd in enumerate(cmds):
+                runs[k].append(run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_ON}))
+        for (label, _), rs in zip(modes, runs):
+            outs = [r["out"] for r in rs]
+            f0 = statistics.median(float(re.search(r"\(no temporal\) ([0-9.]+) s", o).group(1))
+                                   for o in outs)
+            ft = statistics.median(float(re.search(r"\(temporal\) ([0-9.]+) s", o).group(1))
+                                   for o in outs)
+            steps = {}
+            for o in outs:
+                for name, sec in re.findall(r" (\w+) ([0-9.]+) s",
+                                            o.split("per temporal frame:")[1]):
+                    steps.setdefault(name, []).append(float(sec))
+            split = ", ".join(f"{n} {statistics.median(v):.2f}" for n, v in steps.items())
+            rows.append(f"| {size} | {label} | {f0:.2f} | {ft:.2f} | {median(rs, 'rss'):.0f} "
+                        f"| {split} |")
+            if not TEMPORAL_FRAME.get(size):
+                TEMPORAL_FRAME[size] = ft
     lines += ["```", "",
-              "| size | frame 0 s | temporal frame s | per temporal frame, by step (s) |",
-              "|---|---|---|---|"] + rows
+              "| size | layers | frame 0 s | temporal frame s | peak RSS MB "
+              "| per temporal frame, by step (s) |",
+              "|---|---|---|---|---|---|"] + rows
     lines += ["", "Frame 0 runs the whole pyramid; temporal frames start from the previous "
-              "frame's field. A layer's step includes its advection, the first layer's the frame's "
-              "rendering."]
+              "frame's field. The `layers` step includes the frame's rendering and advection; one "
+              "layer at a time, a layer's step includes its advection, the first layer's the "
+              "frame's rendering. Layers at once fill the cores a layer alone leaves idle (between "
+              "its PatchMatch rounds) and hold more memory at once."]
     return lines
 
 

@@ -2,11 +2,14 @@
 // and outline layers, temporal on) at a chosen size, frames kept in memory (no output files),
 // so the figure is rendering + synthesis + advection + compositing.
 //
-//   shot_bench [--digest] [WIDTHxHEIGHT=1920x1080] [FRAMES=3] [THREADS=0]
+//   shot_bench [--digest] [--one-layer-at-a-time] [WIDTHxHEIGHT=1920x1080] [FRAMES=3] [THREADS=0]
 //
 // Frame 0 has no temporal guide; the figure that matters is the mean of the later frames. The
-// split of those frames by layer follows (a layer's time includes its advection, and the first
-// layer's the frame's rendering; "compositing" runs from the composite's start to the next frame).
+// split of those frames by step follows: as `emaki run` does, the frame's layers are synthesized
+// at once ("layers", with the frame's rendering); with --one-layer-at-a-time, as `emaki run
+// --one-layer-at-a-time` does, one after another, each layer its own step (a layer's time
+// includes its advection, and the first layer's the frame's rendering). "compositing" runs from
+// the composite's start to the next frame.
 // With --digest it also prints a digest of every layer frame and composited frame (equal
 // digests, equal results); computing it adds to the frames' times. Like `emaki`, it starts
 // itself again with huge pages where the kernel takes advice (apps/emaki/huge_pages.h;
@@ -26,15 +29,35 @@
 #include "shot/api.h"
 #include "shot/inputs.h"
 
+namespace {
+
+// The leading flags; false on one it does not know.
+bool take_flags(int& argc, char**& argv, bool& digest, bool& one_layer) {
+  for (; argc > 1 && std::string(argv[1]).starts_with("--"); --argc, ++argv) {
+    const std::string flag = argv[1];
+    if (flag == "--digest")
+      digest = true;
+    else if (flag == "--one-layer-at-a-time")
+      one_layer = true;
+    else
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   emaki::app::restart_with_huge_pages(argv);                      // as `emaki` does
   emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   using namespace emaki;
   int width = 1920, height = 1080, frames = 3, threads = 0;
-  const bool digest = argc > 1 && std::string(argv[1]) == "--digest";
-  if (digest) --argc, ++argv;
-  if (argc > 1 && std::sscanf(argv[1], "%dx%d", &width, &height) != 2) {
-    std::fprintf(stderr, "usage: shot_bench [--digest] [WIDTHxHEIGHT] [FRAMES] [THREADS]\n");
+  bool digest = false, one_layer = false;
+  if (!take_flags(argc, argv, digest, one_layer) ||
+      (argc > 1 && std::sscanf(argv[1], "%dx%d", &width, &height) != 2)) {
+    std::fprintf(stderr,
+                 "usage: shot_bench [--digest] [--one-layer-at-a-time] [WIDTHxHEIGHT] [FRAMES] "
+                 "[THREADS]\n");
     return 2;
   }
   if (argc > 2) frames = std::max(2, std::atoi(argv[2]));
@@ -54,6 +77,7 @@ int main(int argc, char** argv) {
     auto t = std::chrono::steady_clock::now();
     int last = -1;
     pipeline::RunOptions o;
+    o.concurrent_layers = !one_layer;  // as `emaki run` does
     // Steps (a layer, or compositing) of the temporal frames: each runs from its progress tick
     // to the next one.
     std::vector<std::string> order;
@@ -71,7 +95,7 @@ int main(int argc, char** argv) {
     o.progress = [&](const pipeline::Progress& p) {
       const auto now = std::chrono::steady_clock::now();
       end_step(now);
-      step = p.layer.empty() ? "compositing" : p.layer;
+      step = p.layer.empty() ? "compositing" : one_layer ? p.layer : "layers";
       step_frame = p.frame;
       step_t = now;
       if (!p.layer.empty() || p.frame == last) return;

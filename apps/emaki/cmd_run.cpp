@@ -106,6 +106,10 @@ int run_run(const Args& args) {
   app.add_flag("--timings", timings,
                "also print where the time went: wall and CPU seconds (all threads) of each stage, "
                "named as the farm's tasks (prepare, passes, layers, composite, previews)");
+  bool one_layer = false;
+  app.add_flag("--one-layer-at-a-time", one_layer,
+               "synthesize a frame's layers one after another instead of at once (less memory "
+               "at once, more time)");
   c.bind_previews(app);
   if (parse_cli(app, args)) return 0;
   StageClock clock;
@@ -113,6 +117,7 @@ int run_run(const Args& args) {
   shot::Request request = c.request("run");
   request.force = force;
   request.error_maps = error_maps;
+  request.concurrent_layers = !one_layer;
   if (timings) request.stages = &clock;
   const shot::RunResult r = shot::run(shot, request);
   end_progress_line();

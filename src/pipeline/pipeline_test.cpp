@@ -418,16 +418,25 @@ TEST(Pipeline, StageClockChargesEachStageAndChangesNoFrame) {
   EXPECT_EQ(plain.frames, timed.frames);
 }
 
-// RunOptions::concurrent_layers: the layers that start no chain at a frame (every layer at the
-// first frame, frame-by-frame layers at every frame) made at once give the same values.
+// RunOptions::concurrent_layers: a frame's layers made at once give the same values and fields,
+// whether they start no chain there (every layer at the first frame, frame-by-frame layers at
+// every frame) or continue one, sharing an advection field (same guide, patch size and seed) or
+// each with its own.
 TEST(Pipeline, ConcurrentLayersGiveTheSameFrames) {
   Shot shot = tiny_shot();
+  ASSERT_TRUE(shot.layers[0].temporal.enabled);
   shot.layers.push_back(shot.layers[0]);
   shot.layers[1].name = "second";
   shot.layers[1].temporal.enabled = false;
   shot.layers.push_back(shot.layers[1]);
   shot.layers[2].name = "third";
   shot.layers[2].synth.seed = 7;
+  shot.layers.push_back(shot.layers[0]);
+  shot.layers[3].name = "shares_the_field";
+  shot.layers[3].synth.uniformity = 2.0f * shot.layers[0].synth.uniformity + 1.0f;
+  shot.layers.push_back(shot.layers[0]);
+  shot.layers[4].name = "own_field";
+  shot.layers[4].synth.seed = 11;
   const SlidingFrames frames(40, 30);
   const auto ex = tiny_exemplar();
   MemoryStore one, all;
@@ -439,6 +448,14 @@ TEST(Pipeline, ConcurrentLayersGiveTheSameFrames) {
   for (const auto& [key, a] : one.layers) {
     const Image<float>& b = all.layers.at(key);
     EXPECT_EQ(std::memcmp(a.row(0), b.row(0), a.bytes()), 0) << key.first << " " << key.second;
+  }
+  ASSERT_EQ(one.fields.size(), all.fields.size());
+  EXPECT_FALSE(one.fields.empty());
+  for (const auto& [key, a] : one.fields) {
+    const auto& b = all.fields.at(key);
+    EXPECT_EQ(a.first, b.first) << key.first << " " << key.second;
+    EXPECT_EQ(std::memcmp(a.second.row(0), b.second.row(0), a.second.bytes()), 0)
+        << key.first << " " << key.second;
   }
 }
 

@@ -361,13 +361,19 @@ class ShotRun {
     return frames_.passes(f);
   }
 
-  // Synthesizes the layers frame f still needs into `now` (parallel to prepared_); the others
-  // are read lazily, only if the chain or the composite needs them. True if any was.
-  bool synthesize_frame(int f, std::vector<Held>& now) {
-    bool changed = false;
-    // The fields the farm's passes task made ahead are read only when a layer advects.
-    AdvectionFields fields([this, f] { return frames_.kept_fields(f); }, o_.stages);
-    std::vector<std::optional<LayerFrame>> made = independent_layers(f);
+  // What a layer frame f needs is made from: its value and field at f - 1 when it continues its
+  // chain there.
+  struct Job {
+    std::size_t i = 0;  // into prepared_
+    const Image<float>* previous = nullptr;
+    const Image<float>* previous_passes = nullptr;
+    ImageView<const int32_t> previous_nnf;
+  };
+
+  // The layers frame f still needs, with what they are made from (read if not held); the others
+  // count as reused.
+  std::vector<Job> jobs_of(int f, std::vector<Held>& now) {
+    std::vector<Job> jobs;
     for (std::size_t i = 0; i < prepared_.size(); ++i) {
       const Layer& l = *prepared_[i].layer;
       now[i].frame = f;
@@ -375,8 +381,8 @@ class ShotRun {
         ++report_.reused;
         continue;
       }
-      const Image<float>* previous = nullptr;
-      const Image<float>* previous_passes = nullptr;
+      Job j;
+      j.i = i;
       if (continues_chain(l, f)) {
         if (held_[i].frame != f - 1 || held_[i].value.empty()) {
           held_[i].frame = f - 1;
@@ -386,17 +392,45 @@ class ShotRun {
                              : Image<int32_t>();
         }
         if (prev_passes_.frame != f - 1) prev_passes_ = {f - 1, read_passes(f - 1), {}};
-        previous = &held_[i].value;
-        previous_passes = &prev_passes_.value;
+        j.previous = &held_[i].value;
+        j.previous_passes = &prev_passes_.value;
+        j.previous_nnf = held_[i].nnf.cview();
       }
-      const ImageView<const int32_t> previous_nnf =
-          previous && held_[i].frame == f - 1 ? held_[i].nnf.cview() : ImageView<const int32_t>{};
+      jobs.push_back(j);
+    }
+    return jobs;
+  }
+
+  // Synthesizes the layers frame f still needs into `now` (parallel to prepared_); the others
+  // are read lazily, only if the chain or the composite needs them. True if any was.
+  bool synthesize_frame(int f, std::vector<Held>& now) {
+    // The fields the farm's passes task made ahead are read only when a layer advects.
+    AdvectionFields fields([this, f] { return frames_.kept_fields(f); }, o_.stages);
+    const std::vector<Job> jobs = jobs_of(f, now);
+    const auto synthesize = [&](const Job& j) {
+      return synthesize_layer(prepared_[j.i], passes(f).cview(), f, j.previous, j.previous_passes,
+                              j.previous_nnf, &fields, &o_);
+    };
+    std::vector<std::optional<LayerFrame>> made(prepared_.size());
+    if (o_.concurrent_layers && jobs.size() >= 2) {
+      for (const Job& j : jobs) tick(f, prepared_[j.i].layer->name);
+      // The advection fields first, on every thread (and charged to the stage clock here): the
+      // layers then only read them. A thread waiting inside its layer starts no other one.
+      const ImageView<const float> p = passes(f).cview();
+      for (const Job& j : jobs)
+        if (j.previous) fields.prepare(*prepared_[j.i].layer, j.previous_passes->cview(), p, f);
+      parallel_for(int64_t(jobs.size()), 1, [&](int64_t a, int64_t b) {
+        for (int64_t k = a; k < b; ++k)
+          isolated([&] { made[jobs[std::size_t(k)].i] = synthesize(jobs[std::size_t(k)]); });
+      });
+    }
+    for (const Job& j : jobs) {
+      const std::size_t i = j.i;
+      const Layer& l = *prepared_[i].layer;
       if (!made[i]) tick(f, l.name);
-      LayerFrame r = made[i] ? std::move(*made[i])
-                             : synthesize_layer(prepared_[i], passes(f).cview(), f, previous,
-                                                previous_passes, previous_nnf, &fields, &o_);
+      LayerFrame r = made[i] ? std::move(*made[i]) : synthesize(j);
       if (l.temporal.ink_ratio > 0.0f)
-        ink_pins_[i].pin(l.temporal, first_, chain_last_, f, previous != nullptr,
+        ink_pins_[i].pin(l.temporal, first_, chain_last_, f, j.previous != nullptr,
                          prepared_[i].value_channels, passes(f).cview(), r.value, r.confidence,
                          [&](int k) { return measured_ink(i, k, f); });
       if (!r.error.empty())
@@ -415,9 +449,8 @@ class ShotRun {
       if (l.temporal.enabled && l.temporal.warm_start && !l.temporal.keep_every_field && f > first_)
         store_.remove_field(l, f - 1);
       ++report_.synthesized;
-      changed = true;
     }
-    return changed;
+    return !jobs.empty();
   }
 
   // TemporalSpec::ink_refresh: the reference measured on a fresh transfer of layer i's frame r,
@@ -435,28 +468,6 @@ class ShotRun {
                                      prepared_[i].value_channels, p);
     ref.frame = r;
     return ref;
-  }
-
-  // With RunOptions::concurrent_layers, the layers frame f needs that do not continue a chain
-  // there, synthesized at once (parallel to prepared_; the others stay empty).
-  std::vector<std::optional<LayerFrame>> independent_layers(int f) {
-    std::vector<std::optional<LayerFrame>> made(prepared_.size());
-    std::vector<std::size_t> alone;
-    for (std::size_t i = 0; i < prepared_.size(); ++i) {
-      const Layer& l = *prepared_[i].layer;
-      if (needs(l, f) && !continues_chain(l, f)) alone.push_back(i);
-    }
-    if (!o_.concurrent_layers || alone.size() < 2) return made;
-    const ImageView<const float> p = passes(f).cview();
-    for (std::size_t i : alone) tick(f, prepared_[i].layer->name);
-    parallel_for(int64_t(alone.size()), 1, [&](int64_t a, int64_t b) {
-      for (int64_t k = a; k < b; ++k) {
-        AdvectionFields fields;  // unused without a predecessor
-        made[alone[k]] =
-            synthesize_layer(prepared_[alone[k]], p, f, nullptr, nullptr, {}, &fields, &o_);
-      }
-    });
-    return made;
   }
 
   // Before a forced run's last frame f of a temporal layer replaces the finished one: when the

@@ -85,9 +85,9 @@ struct RunOptions {
   bool force = false;               // synthesize again even when finished
   bool composite = true;            // false: layers only (a farm's layer task)
   bool error_maps = false;  // each synthesized layer frame's error map, to Store::write_qa_map
-  // The layers of a frame that do not continue a temporal chain there (every layer of a shot's
-  // first frame, or frame by frame) synthesized at once rather than one after another: the
-  // same results, less wall time on small frames (emaki lookdev), more memory at once.
+  // The layers a frame needs synthesized at once rather than one after another: the same
+  // results, less wall time (a layer's synthesis leaves threads idle between its PatchMatch
+  // rounds, which another layer's work fills), more memory at once.
   bool concurrent_layers = false;
   std::function<void(const Progress&)> progress;
   // Polled during each synthesis (synth::Params::cancel): true stops the run with
