@@ -249,8 +249,8 @@ def section_shot(a, build):
               "|---|---|---|---|---|---|"] + rows
     lines += ["", "Frame 0 runs the whole pyramid; temporal frames start from the previous "
               "frame's field. The `layers` step includes the frame's rendering and advection; one "
-              "layer at a time, a layer's step includes its advection, the first layer's the "
-              "frame's rendering. Layers at once fill the cores a layer alone leaves idle (between "
+              "layer at a time, the first layer's step includes the frame's rendering and every "
+              "layer's advection. Layers at once fill the cores a layer alone leaves idle (between "
               "its PatchMatch rounds) and hold more memory at once."]
     return lines
 

@@ -6,9 +6,9 @@
 //
 // Frame 0 has no temporal guide; the figure that matters is the mean of the later frames. The
 // split of those frames by step follows: as `emaki run` does, the frame's layers are synthesized
-// at once ("layers", with the frame's rendering); with --one-layer-at-a-time, as `emaki run
-// --one-layer-at-a-time` does, one after another, each layer its own step (a layer's time
-// includes its advection, and the first layer's the frame's rendering). "compositing" runs from
+// at once ("layers", with the frame's rendering and advection); with --one-layer-at-a-time, as
+// `emaki run --one-layer-at-a-time` does, one after another, each layer its own step (the first
+// layer's includes the frame's rendering and every layer's advection). "compositing" runs from
 // the composite's start to the next frame.
 // With --digest it also prints a digest of every layer frame and composited frame (equal
 // digests, equal results); computing it adds to the frames' times. Like `emaki`, it starts

@@ -4,224 +4,29 @@
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
 #include <optional>
 
-#include "composite/composite.h"
 #include "core/error.h"
 #include "core/fnv.h"
 #include "core/parallel.h"
-#include "core/rng.h"
 #include "core/shot_keys.h"
 #include "pipeline/ink_ratio.h"
+#include "pipeline/layer_frame.h"
 #include "pipeline/qa_maps.h"
 #include "pipeline/temporal_guide.h"
-#include "pipeline/tone_anchor.h"
 #include "render/passes.h"
-#include "synth/synthesizer.h"
 #include "temporal/advection.h"
-#include "temporal/guide_change.h"
 
 namespace emaki::pipeline {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// A layer with its exemplar cut into what every frame's synthesis reads.
-struct PreparedLayer {
-  const Layer* layer = nullptr;
-  int value_channels = 1;
-  Image<float> style;  // A': the touch (1 channel) or the painting's RGB
-  // One per layer->guides entry: ExemplarImages::guides' or cut here.
-  std::vector<std::shared_ptr<const Image<float>>> source_guides;
-  std::vector<const Image<float>*> painted_maps;  // per guide: its painted weight map, or null
-  Image<float> temporal_style;  // A' low-passed for the temporal guide (guide_sigma), or empty
-  TemporalSharpening sharpening;
-  AnchorExemplar anchor;  // the tone anchor's exemplar side (TemporalSpec::anchor), or empty
-};
-
-PreparedLayer prepare(const Layer& layer, const ExemplarImages& ex, const WeightMapImages& maps,
-                      int frame_width, int frame_height) {
-  PreparedLayer p;
-  p.layer = &layer;
-  p.value_channels = layer.single_colour ? 1 : 3;
-  if (layer.single_colour) {
-    p.style = composite::touch(ex.painting.cview(), layer.channel);
-  } else {
-    if (ex.painting.channels() < 3)
-      throw Error(shot_keys::layer_key(layer.name, shot_keys::kSingleColour),
-                  "false needs an RGB painting, its exemplar's painting is grey");
-    p.style = extract(ex.painting.cview(), 0, 3);
-  }
-  for (const GuideSpec& g : layer.guides) {
-    const auto cut = ex.guides.find(g.pass);
-    p.source_guides.push_back(
-        cut != ex.guides.end()
-            ? cut->second
-            : std::make_shared<const Image<float>>(extract_pass(ex.passes.cview(), g.pass)));
-    const auto it = g.map_image.empty() ? maps.end() : maps.find(g.map_image);
-    CHECK(g.map_image.empty() || it != maps.end());  // shot::load_weight_maps read every one
-    p.painted_maps.push_back(it == maps.end() ? nullptr : &it->second);
-  }
-  p.sharpening = temporal_sharpening(layer.temporal, frame_width, frame_height, p.style.width(),
-                                     p.style.height());
-  if (layer.temporal.enabled && p.sharpening.guide_sigma > 0.0f)
-    p.temporal_style = temporal::low_pass(p.style.cview(), p.sharpening.guide_sigma);
-  if (layer.temporal.enabled && layer.temporal.anchor > 0) {
-    std::vector<synth::Plane> sources;
-    for (const auto& g : p.source_guides) sources.push_back(g->cview());
-    p.anchor = anchor_exemplar(p.style.cview(), sources, layer.temporal.anchor);
-  }
-  return p;
-}
-
-// A layer's result at one frame: its value and, for a temporal layer, the field that made it
-// (the next frame's warm start).
-struct LayerFrame {
-  Image<float> value;
-  Image<int32_t> nnf;
-  Image<float> error;       // when asked: the synthesis error (synth::Result::error)
-  Image<float> confidence;  // at a temporal frame: the temporal guide's, else empty
-};
-
-// The temporal guide pair of a layer at a temporal frame: B'adv and its confidence, both sides
-// low-passed with guide_sigma. `target` holds what the pair's target view points into.
-struct TemporalPair {
-  temporal::Advection advected;
-  Image<float> target;
-};
-
-// Whether the layer's temporal pair joins its main transfer. A pair of weight 0 changes no
-// patch's error (its channels quantise to 0 on both sides; the other channels' weights, and with
-// them the distances and errors, stay the same to the bit): it is left out, and its advection
-// makes the confidence alone (the warm start's holes) — unless a guide's weight is negative
-// (1 / the number of pairs, which leaving one out would change).
-bool keeps_temporal_pair(const Layer& l) {
-  return l.temporal.weight != 0.0f ||
-         std::any_of(l.guides.begin(), l.guides.end(),
-                     [](const GuideSpec& g) { return g.weight < 0.0f; });
-}
-
-void add_temporal_guide(const PreparedLayer& p, ImageView<const float> passes,
-                        const Image<float>& mask, int frame, const Image<float>& previous,
-                        const Image<float>& previous_passes, AdvectionFields* fields,
-                        TemporalPair& t, synth::Inputs& inputs) {
-  const Layer& l = *p.layer;
-  const bool kept = keeps_temporal_pair(l);
-  t.advected =
-      advect_layer(l, passes, mask, previous.cview(), previous_passes.cview(), frame, fields, kept);
-  if (!kept) return;
-  const bool low = p.sharpening.guide_sigma > 0.0f;
-  if (low)
-    t.target = temporal::low_pass(t.advected.value.cview(), p.sharpening.guide_sigma,
-                                  mask.empty() ? ImageView<const float>{} : mask.cview());
-  synth::GuidePair pair{shot_keys::layer_key(l.name, shot_keys::kTemporal),
-                        low ? p.temporal_style.cview() : p.style.cview(),
-                        low ? t.target.cview() : t.advected.value.cview(), l.temporal.weight};
-  if (!t.advected.confidence.empty()) pair.weight_map = synth::Plane(t.advected.confidence.cview());
-  inputs.guides.push_back(pair);
-}
-
-// The tone anchor at a temporal frame (TemporalSpec::anchor, pipeline/tone_anchor.h): with a
-// temporal guide, its target B'adv anchored to a fresh transfer's tone (moved out of the result).
-Anchor anchor_layer(const PreparedLayer& p, int frame, const synth::Params& params,
-                    const Image<float>& mask, TemporalPair& t, synth::Inputs& inputs) {
-  const Layer& l = *p.layer;
-  const bool guide = l.temporal.weight > 0.0f;
-  if (l.temporal.anchor <= 0 ||
-      (!guide && !l.temporal.anchor_holes && l.temporal.ink_match <= 0.0f))
-    return {};
-  synth::Inputs fresh = inputs;
-  if (keeps_temporal_pair(l)) fresh.guides.pop_back();
-  synth::Params fresh_params = params;
-  fresh_params.seed = frame_seed(l, frame, 2);
-  fresh_params.finest_search_vote_iters = l.temporal.anchor_finest_iters;
-  Anchor a = anchor_tone(fresh, p.anchor, fresh_params, t.advected.value.cview(), p.value_channels,
-                         mask, l.temporal.anchor_sigma, l.temporal.anchor_rate);
-  if (guide && !a.target.empty()) {
-    t.target = std::move(a.target);
-    inputs.guides.back().target = synth::Plane(t.target.cview());
-  }
-  if (!l.temporal.anchor_holes) a.nnf = {};
-  return a;
-}
-
-// One layer at one frame. `previous`: B'(t-1) of this layer and the passes of t-1, when the
-// temporal chain continues; `previous_nnf`: the field of t-1 (empty: none, the whole pyramid
-// runs). `fields`: the frame's advection fields, shared by its layers. `o`: the run's error
-// maps and cancel hook, if any.
-LayerFrame synthesize_layer(const PreparedLayer& p, ImageView<const float> passes, int frame,
-                            const Image<float>* previous, const Image<float>* previous_passes,
-                            ImageView<const int32_t> previous_nnf, AdvectionFields* fields,
-                            const RunOptions* o = nullptr) {
-  const Layer& l = *p.layer;
-  const Image<float> mask = layer_mask(passes, l.mask);
-  const int n = p.value_channels;
-  if (!mask.empty()) {
-    bool any = false;
-    for (int y = 0; y < mask.height() && !any; ++y)
-      for (int x = 0; x < mask.width() && !any; ++x) any = mask(x, y) > 0.5f;
-    if (!any)  // nothing to synthesize: transparent, and no field
-      return {Image<float>(passes.width, passes.height, n + 1), {}, {}, {}};
-  }
-  std::vector<Image<float>> targets, pass_maps;
-  targets.reserve(l.guides.size());  // views point into them: no reallocation
-  pass_maps.reserve(l.guides.size());
-  synth::Inputs inputs;
-  inputs.style = p.style.cview();
-  inputs.style_name = shot_keys::exemplar_key(l.exemplar, shot_keys::kPainting);
-  for (std::size_t i = 0; i < l.guides.size(); ++i) {
-    const GuideSpec& g = l.guides[i];
-    targets.push_back(extract_pass(passes, g.pass));
-    synth::GuidePair pair{shot_keys::layer_guide(l.name, g.pass), p.source_guides[i]->cview(),
-                          targets.back().cview(), g.weight};
-    if (!g.map_pass.empty()) {
-      pass_maps.push_back(extract_pass(passes, g.map_pass));
-      pair.weight_map = synth::Plane(pass_maps.back().cview());
-    } else if (p.painted_maps[i]) {
-      pair.weight_map = synth::Plane(p.painted_maps[i]->cview());
-      pair.weight_map_name = g.map_image;
-    }
-    inputs.guides.push_back(pair);
-  }
-  TemporalPair temporal_pair;
-  const temporal::Advection& advected = temporal_pair.advected;
-  if (previous && previous_passes)
-    add_temporal_guide(p, passes, mask, frame, *previous, *previous_passes, fields, temporal_pair,
-                       inputs);
-  if (!mask.empty()) inputs.target_mask = mask.cview();
-  synth::Params params = synth_params(l.synth, frame_seed(l, frame, 0));
-  if (o) params.cancel = o->cancel;
-  const bool chained = previous && previous_passes;
-  const Anchor anchor =
-      chained ? anchor_layer(p, frame, params, mask, temporal_pair, inputs) : Anchor{};
-  // With a temporal guide, B'adv carries the previous frame's converged texture: one search-vote
-  // iteration at the finest level instead of two keeps flicker and the judge's style energy
-  // within their bars (docs/design/advection.md) and saves a quarter of the time per frame.
-  Image<int32_t> warm;
-  Image<float> uniformity_map;
-  if (chained) {
-    params.finest_search_vote_iters = l.temporal.finest_iters;
-    const temporal::AdvectionField* field = fields ? fields->find(l, frame) : nullptr;
-    if (l.temporal.warm_start && field && !previous_nnf.empty()) {
-      warm = warm_field(l, previous_nnf, *field, advected.confidence, anchor.nnf,
-                        p.sharpening.coherence_radius);
-      params.initial_nnf = warm.cview();
-      params.warm_sharp_estimate = p.sharpening.sharp_estimate;
-      warm_schedule(l.synth, l.temporal, params);
-    }
-    temporal_uniformity(l.temporal, targets, mask, params, uniformity_map);
-  }
-  synth::OutputRequest request;
-  request.nnf = l.temporal.enabled && l.temporal.warm_start;
-  request.error = o && o->error_maps;  // measured once the result is made: it does not change it
-  synth::Result r = synth::synthesize(inputs, params, request);
-  match_ink(r.image, n, anchor, mask, advected.confidence, l.temporal.ink_sigma,
-            l.temporal.ink_match);
-  return {std::move(r.image), std::move(r.nnf), std::move(r.error),
-          std::move(temporal_pair.advected.confidence)};
-}
+using detail::advect_previous;
+using detail::LayerFrame;
+using detail::prepare;
+using detail::PreparedLayer;
+using detail::synthesize_layer;
 
 std::vector<const Layer*> selected_layers(const Shot& shot, const std::vector<std::string>& names) {
   std::vector<const Layer*> out;
@@ -365,8 +170,8 @@ class ShotRun {
   // chain there.
   struct Job {
     std::size_t i = 0;  // into prepared_
-    const Image<float>* previous = nullptr;
-    const Image<float>* previous_passes = nullptr;
+    bool chained = false;
+    temporal::Advection advected;  // chained: B'(t-1) carried to t
     ImageView<const int32_t> previous_nnf;
   };
 
@@ -391,14 +196,28 @@ class ShotRun {
                              ? store_.read_field(l, f - 1, value_digest(held_[i].value.cview()))
                              : Image<int32_t>();
         }
-        if (prev_passes_.frame != f - 1) prev_passes_ = {f - 1, read_passes(f - 1), {}};
-        j.previous = &held_[i].value;
-        j.previous_passes = &prev_passes_.value;
+        j.chained = true;
         j.previous_nnf = held_[i].nnf.cview();
       }
-      jobs.push_back(j);
+      jobs.push_back(std::move(j));
     }
     return jobs;
+  }
+
+  // B'(t-1) of the chained jobs carried to frame f, all before any is synthesized; then what only
+  // the advection reads is let go (the passes of f - 1, the values B'(t-1), all but the nnf of
+  // the advection fields): a frame's synthesis holds its own passes and the warm starts' fields.
+  void advect_jobs(int f, std::vector<Job>& jobs, AdvectionFields& fields) {
+    if (std::none_of(jobs.begin(), jobs.end(), [](const Job& j) { return j.chained; })) return;
+    if (prev_passes_.frame != f - 1) prev_passes_ = {f - 1, read_passes(f - 1), {}};
+    for (Job& j : jobs)
+      if (j.chained) {
+        j.advected = advect_previous(prepared_[j.i], passes(f).cview(), f, held_[j.i].value,
+                                     prev_passes_.value.cview(), &fields);
+        held_[j.i].value = {};
+      }
+    prev_passes_ = {};
+    fields.keep_only_warm_start_fields();
   }
 
   // Synthesizes the layers frame f still needs into `now` (parallel to prepared_); the others
@@ -406,32 +225,30 @@ class ShotRun {
   bool synthesize_frame(int f, std::vector<Held>& now) {
     // The fields the farm's passes task made ahead are read only when a layer advects.
     AdvectionFields fields([this, f] { return frames_.kept_fields(f); }, o_.stages);
-    const std::vector<Job> jobs = jobs_of(f, now);
-    const auto synthesize = [&](const Job& j) {
-      return synthesize_layer(prepared_[j.i], passes(f).cview(), f, j.previous, j.previous_passes,
+    std::vector<Job> jobs = jobs_of(f, now);
+    if (jobs.empty()) return false;
+    const bool together = o_.concurrent_layers && jobs.size() >= 2;
+    for (std::size_t k = 0; k < (together ? jobs.size() : 1); ++k)
+      tick(f, prepared_[jobs[k].i].layer->name);
+    advect_jobs(f, jobs, fields);
+    const auto synthesize = [&, p = passes(f).cview()](Job& j) {  // the passes read here, once
+      return synthesize_layer(prepared_[j.i], p, f, j.chained ? &j.advected : nullptr,
                               j.previous_nnf, &fields, &o_);
     };
     std::vector<std::optional<LayerFrame>> made(prepared_.size());
-    if (o_.concurrent_layers && jobs.size() >= 2) {
-      for (const Job& j : jobs) tick(f, prepared_[j.i].layer->name);
-      // The advection fields first, on every thread (and charged to the stage clock here): the
-      // layers then only read them. A thread waiting inside its layer starts no other one.
-      const ImageView<const float> p = passes(f).cview();
-      for (const Job& j : jobs)
-        if (j.previous) fields.prepare(*prepared_[j.i].layer, j.previous_passes->cview(), p, f);
+    if (together)  // a thread waiting inside its layer starts no other one
       parallel_for(int64_t(jobs.size()), 1, [&](int64_t a, int64_t b) {
         for (int64_t k = a; k < b; ++k)
           isolated([&] { made[jobs[std::size_t(k)].i] = synthesize(jobs[std::size_t(k)]); });
       });
-    }
-    for (const Job& j : jobs) {
+    for (Job& j : jobs) {
       const std::size_t i = j.i;
       const Layer& l = *prepared_[i].layer;
-      if (!made[i]) tick(f, l.name);
+      if (!together && &j != &jobs.front()) tick(f, l.name);
       LayerFrame r = made[i] ? std::move(*made[i]) : synthesize(j);
       if (l.temporal.ink_ratio > 0.0f)
-        ink_pins_[i].pin(l.temporal, first_, chain_last_, f, j.previous != nullptr,
-                         prepared_[i].value_channels, passes(f).cview(), r.value, r.confidence,
+        ink_pins_[i].pin(l.temporal, first_, chain_last_, f, j.chained, prepared_[i].value_channels,
+                         passes(f).cview(), r.value, r.confidence,
                          [&](int k) { return measured_ink(i, k, f); });
       if (!r.error.empty())
         store_.write_qa_map("error", l, f,
@@ -450,7 +267,7 @@ class ShotRun {
         store_.remove_field(l, f - 1);
       ++report_.synthesized;
     }
-    return !jobs.empty();
+    return true;
   }
 
   // TemporalSpec::ink_refresh: the reference measured on a fresh transfer of layer i's frame r,
@@ -463,7 +280,7 @@ class ShotRun {
     RunOptions measured_only = o_;  // cancellable, but no error map: the result is only measured
     measured_only.error_maps = false;
     const LayerFrame fresh =
-        synthesize_layer(prepared_[i], p, r, nullptr, nullptr, {}, &none, &measured_only);
+        synthesize_layer(prepared_[i], p, r, nullptr, {}, &none, &measured_only);
     InkReference ref = ink_reference(prepared_[i].layer->temporal, fresh.value.cview(),
                                      prepared_[i].value_channels, p);
     ref.frame = r;
@@ -556,7 +373,7 @@ Image<float> synthesize_alone(const Layer& layer, const ExemplarImages& exemplar
                               ImageView<const float> passes, int frame,
                               const WeightMapImages& weight_maps) {
   return synthesize_layer(prepare(layer, exemplar, weight_maps, passes.width, passes.height),
-                          passes, frame, nullptr, nullptr, {}, nullptr)
+                          passes, frame, nullptr, {}, nullptr)
       .value;
 }
 

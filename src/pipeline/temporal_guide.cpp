@@ -113,6 +113,16 @@ const Image<float>& AdvectionFields::motion(ImageView<const float> passes) {
   return cut(passes, -1);
 }
 
+void AdvectionFields::keep_only_warm_start_fields() {
+  const std::lock_guard lock(mutex_);
+  cuts_.clear();
+  for (auto& e : entries_) {
+    e->field.error = {};
+    e->field.visible = {};
+    e->field.shares = {};
+  }
+}
+
 const Image<float>& AdvectionFields::cut(ImageView<const float> passes, int what) {
   const std::lock_guard lock(mutex_);
   for (const auto& c : cuts_)

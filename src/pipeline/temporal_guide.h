@@ -79,6 +79,9 @@ class AdvectionFields {
   // image while this object lives.
   const Image<float>& guide(ImageView<const float> passes, AdvectionGuide guide);
   const Image<float>& motion(ImageView<const float> passes);
+  // Lets go of what only the advection reads: the cuts, and each field's error, visibility and id
+  // shares; the fields' nnf stay (the warm starts carry B'(t-1)'s field along them).
+  void keep_only_warm_start_fields();
 
  private:
   struct Cut {
