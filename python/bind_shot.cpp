@@ -53,11 +53,12 @@ class PyShot {
 
   py::dict run(const py::object& frames, const py::object& layers, bool force, bool previews,
                const py::object& threads, const py::object& progress,
-               const py::object& max_memory_mb) {
+               const py::object& max_memory_mb, bool one_layer_at_a_time) {
     shot::Request r = request(frames, threads, max_memory_mb);
     r.layers = layer_names(layers);
     r.force = force;
     r.previews = previews;
+    r.concurrent_layers = !one_layer_at_a_time;  // as `emaki run` does
     PendingError pending;
     bool stopped = false;
     // The GIL is taken back for a moment at each layer-frame: Ctrl-C and the callback.
@@ -287,9 +288,9 @@ void bind_shot(py::module_& m) {
       .def("run", &PyShot::run, py::kw_only(), py::arg("frames") = py::none(),
            py::arg("layers") = py::none(), py::arg("force") = false, py::arg("previews") = true,
            py::arg("threads") = py::none(), py::arg("progress") = py::none(),
-           py::arg("max_memory_mb") = py::none(),
+           py::arg("max_memory_mb") = py::none(), py::arg("one_layer_at_a_time") = false,
            "run(self, *, frames=None, layers=None, force=False, previews=True, threads=None, "
-           "progress=None, max_memory_mb=None)\n--\n\n"
+           "progress=None, max_memory_mb=None, one_layer_at_a_time=False)\n--\n\n"
            "Synthesizes every layer of the requested frames (with the temporal chain), composites "
            "them and writes the shot's outputs; resumes after the last finished frame.\n"
            "frames: None (all), a frame, or (first, last) inclusive, within the shot's frames.\n"
@@ -299,7 +300,10 @@ void bind_shot(py::module_& m) {
            "each layer-frame (layer None: compositing); raising from it stops the run.\n"
            "max_memory_mb: refuse to start when the estimated peak memory exceeds it (what the "
            "machine has available is always checked).\n"
-           "The GIL is released while it runs; Ctrl-C stops it after the current layer-frame.\n"
+           "one_layer_at_a_time: synthesize a frame's layers one after another (less memory at "
+           "once, more time) instead of at once; the results are the same.\n"
+           "The GIL is released while it runs; Ctrl-C stops it before the next layer-frame starts "
+           "(a frame's layers start together unless one_layer_at_a_time).\n"
            "Returns {synthesized, reused, composited, frames, previews (a list of "
            "pathlib.Path)}.")
       .def(

@@ -155,6 +155,7 @@ class Shot:
         threads: Optional[int] = None,
         progress: Optional[Callable[[dict], object]] = None,
         max_memory_mb: Optional[int] = None,
+        one_layer_at_a_time: bool = False,
     ) -> dict: ...
     def composite(
         self,

@@ -75,6 +75,10 @@ def test_a_shot_run_from_python_equals_emaki_run(tmp_path):
     # Resuming: nothing left to do.
     assert shot.run()["synthesized"] == 0
     assert emaki.Shot.load(str(shot_file)).run(threads=1)["reused"] == 6
+    # A frame's layers one after another: the same files.
+    apart = emaki.Shot.from_dict(tiny(tmp_path / "apart"))
+    assert apart.run(one_layer_at_a_time=True)["synthesized"] == 6
+    assert digests(tmp_path / "apart") == py
 
 
 def test_composite_flicker_and_plan(tmp_path):
