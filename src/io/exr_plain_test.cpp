@@ -71,7 +71,8 @@ void expect_equal(const Image<float>& a, const Image<float>& b) {
 }
 
 TEST(ExrPlain, ReadsWhatOpenImageIoWrites) {
-  const fs::path dir = test::fresh_test_dir("emaki_exr_plain");
+  const test::TempDir scratch("exr_plain");
+  const fs::path& dir = scratch.path();
   const Image<float> im = pattern(37, 23, int(kNames.size()));
   const std::vector<std::string> picked = {"depth.Y", "normal.X", "alpha.A", "normal.X"};
   for (const char* compression : {"none", "zips", "zip"})
@@ -97,7 +98,8 @@ TEST(ExrPlain, ReadsWhatOpenImageIoWrites) {
 }
 
 TEST(ExrPlain, OpenImageIoReadsWhatEmakiWrites) {
-  const fs::path dir = test::fresh_test_dir("emaki_exr_plain");
+  const test::TempDir scratch("exr_plain");
+  const fs::path& dir = scratch.path();
   const Image<float> im = pattern(41, 35, int(kNames.size()));
   for (const char* compression : {"none", "zips", "zip"})
     for (const bool half : {true, false}) {
@@ -132,7 +134,8 @@ TEST(ExrPlain, OpenImageIoReadsWhatEmakiWrites) {
 }
 
 TEST(ExrPlain, DeclinesOtherFilesWhichReadAsBefore) {
-  const fs::path dir = test::fresh_test_dir("emaki_exr_plain");
+  const test::TempDir scratch("exr_plain");
+  const fs::path& dir = scratch.path();
   Image<float> im = pattern(9, 5, int(kNames.size()));
   const std::string piz = oiio_write(dir, "piz.exr", im, kNames, "piz");
   EXPECT_FALSE(plain(piz, {"depth.Y"}));
@@ -162,7 +165,8 @@ TEST(ExrPlain, DeclinesOtherFilesWhichReadAsBefore) {
 }
 
 TEST(ExrPlain, DeclinesDamagedFiles) {
-  const fs::path dir = test::fresh_test_dir("emaki_exr_plain");
+  const test::TempDir scratch("exr_plain");
+  const fs::path& dir = scratch.path();
   for (const char* compression : {"none", "zip"}) {
     SCOPED_TRACE(compression);
     const std::string good = oiio_write(dir, "good.exr", pattern(16, 40, 5), kNames, compression);

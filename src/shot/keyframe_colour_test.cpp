@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 const std::string kData = EMAKI_TEST_DATA;
 
 TEST(KeyframeColour, AlbedoIsReadFromThePassesColourSpace) {
-  const fs::path dir = test::fresh_test_dir("emaki_keyframe_colour");
+  const test::TempDir scratch("keyframe_colour");
+  const fs::path& dir = scratch.path();
   const int w = 16, h = 12;
   Image<float> p(w, h, render::kChannelCount);
   for (int y = 0; y < h; ++y)
