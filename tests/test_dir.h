@@ -21,8 +21,8 @@ inline std::filesystem::path fresh_test_dir(const std::string& prefix) {
   return dir;
 }
 
-// A fresh folder under the system's temporary folder, named after the running test and the
-// process, removed with everything in it when the test ends.
+// A fresh folder under the system's temporary folder, named `emaki_NAME_PID`, removed with
+// everything in it when the object goes (the end of the test that holds it).
 class TempDir {
  public:
   explicit TempDir(const std::string& name)

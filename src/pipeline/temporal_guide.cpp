@@ -67,29 +67,19 @@ AdvectionFields::AdvectionFields(std::function<std::vector<KeptField>()> kept, S
 
 const temporal::AdvectionField& AdvectionFields::get(
     const Layer& l, int frame, const std::function<temporal::AdvectionField()>& compute) {
-  const std::lock_guard lock(mutex_);
-  if (const temporal::AdvectionField* f = find_locked(l, frame)) return *f;
+  if (const temporal::AdvectionField* f = find(l, frame)) return *f;
   const StageScope stage(clock_, StageClock::kPasses);
   if (kept_) {
-    std::vector<KeptField> kept;
-    isolated([&] { kept = kept_(); });
-    for (KeptField& k : kept) entries_.push_back(std::make_unique<KeptField>(std::move(k)));
+    for (KeptField& k : kept_()) entries_.push_back(std::make_unique<KeptField>(std::move(k)));
     kept_ = nullptr;
-    if (const temporal::AdvectionField* f = find_locked(l, frame)) return *f;
+    if (const temporal::AdvectionField* f = find(l, frame)) return *f;
   }
-  temporal::AdvectionField field;
-  isolated([&] { field = compute(); });
   entries_.push_back(std::make_unique<KeptField>(
-      KeptField{l.temporal.guide, l.synth.patch_size, frame_seed(l, frame, 1), std::move(field)}));
+      KeptField{l.temporal.guide, l.synth.patch_size, frame_seed(l, frame, 1), compute()}));
   return entries_.back()->field;
 }
 
 const temporal::AdvectionField* AdvectionFields::find(const Layer& l, int frame) const {
-  const std::lock_guard lock(mutex_);
-  return find_locked(l, frame);
-}
-
-const temporal::AdvectionField* AdvectionFields::find_locked(const Layer& l, int frame) const {
   const uint64_t seed = frame_seed(l, frame, 1);
   for (const auto& e : entries_)
     if (e->guide == l.temporal.guide && e->patch_size == l.synth.patch_size && e->seed == seed)
@@ -98,7 +88,6 @@ const temporal::AdvectionField* AdvectionFields::find_locked(const Layer& l, int
 }
 
 std::vector<KeptField> AdvectionFields::release() {
-  const std::lock_guard lock(mutex_);
   std::vector<KeptField> out;
   for (auto& e : entries_) out.push_back(std::move(*e));
   entries_.clear();
@@ -114,7 +103,6 @@ const Image<float>& AdvectionFields::motion(ImageView<const float> passes) {
 }
 
 void AdvectionFields::keep_only_warm_start_fields() {
-  const std::lock_guard lock(mutex_);
   cuts_.clear();
   for (auto& e : entries_) {
     e->field.error = {};
@@ -124,15 +112,12 @@ void AdvectionFields::keep_only_warm_start_fields() {
 }
 
 const Image<float>& AdvectionFields::cut(ImageView<const float> passes, int what) {
-  const std::lock_guard lock(mutex_);
   for (const auto& c : cuts_)
     if (c->passes == passes.data && c->what == what) return c->image;
-  Image<float> image;
-  isolated([&] {
-    image = what < 0 ? extract(passes, render::kMotion, 2)
-                     : advection_guide(passes, static_cast<AdvectionGuide>(what));
-  });
-  cuts_.push_back(std::make_unique<Cut>(Cut{passes.data, what, std::move(image)}));
+  cuts_.push_back(std::make_unique<Cut>(
+      Cut{passes.data, what,
+          what < 0 ? extract(passes, render::kMotion, 2)
+                   : advection_guide(passes, static_cast<AdvectionGuide>(what))}));
   return cuts_.back()->image;
 }
 
@@ -239,19 +224,16 @@ temporal::Advection advect_layer(const Layer& l, ImageView<const float> passes,
   return temporal::advect(a, params, &field);
 }
 
-void AdvectionFields::prepare(const Layer& l, ImageView<const float> previous_passes,
-                              ImageView<const float> passes, int frame) {
-  const temporal::AdvectionInputs a = advection_inputs(l, passes, previous_passes, *this);
-  const synth::Params params = synth_params(l.synth, frame_seed(l, frame, 1));
-  get(l, frame, [&] { return temporal::advection_field(a, params); });
-}
-
 std::vector<KeptField> advection_fields(const Shot& shot, ImageView<const float> previous_passes,
                                         ImageView<const float> passes, int frame) {
   AdvectionFields fields;
   if (frame > shot.source.first_frame)
-    for (const Layer& l : shot.layers)
-      if (l.temporal.enabled) fields.prepare(l, previous_passes, passes, frame);
+    for (const Layer& l : shot.layers) {
+      if (!l.temporal.enabled) continue;
+      const temporal::AdvectionInputs a = advection_inputs(l, passes, previous_passes, fields);
+      const synth::Params params = synth_params(l.synth, frame_seed(l, frame, 1));
+      fields.get(l, frame, [&] { return temporal::advection_field(a, params); });
+    }
   return fields.release();
 }
 

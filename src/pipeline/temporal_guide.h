@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <vector>
 
 #include "core/image.h"
@@ -57,19 +56,12 @@ class AdvectionFields {
   // ahead (FrameSource::kept_fields): a field found there is not computed again. `clock`, when
   // given, is charged the fields' reading and computing as StageClock::kPasses (the farm's passes
   // task makes them).
-  //
-  // Its calls may come from several threads at once (the layers of a frame synthesized
-  // concurrently, RunOptions::concurrent_layers): each is made under one lock, and what a call
-  // computes it computes isolated (core/parallel.h: isolated()), so the thread holding the lock
-  // never takes up another layer's work that would wait for it.
+  // Not synchronized: a run computes a frame's fields on one thread before its layers start;
+  // layers synthesized at once (RunOptions::concurrent_layers) only find() them.
   explicit AdvectionFields(std::function<std::vector<KeptField>()> kept = {},
                            StageClock* clock = nullptr);
   const temporal::AdvectionField& get(const Layer& layer, int frame,
                                       const std::function<temporal::AdvectionField()>& compute);
-  // get() for `layer` at `frame` from the passes of frame - 1 and of frame, with the cuts it
-  // needs: what the layer's synthesis will ask for, made beforehand.
-  void prepare(const Layer& layer, ImageView<const float> previous_passes,
-               ImageView<const float> passes, int frame);
   // The field get() gave `layer` at `frame`, or null when it has not been computed.
   const temporal::AdvectionField* find(const Layer& layer, int frame) const;
   // Every field, moved out (the object then holds none).
@@ -90,8 +82,6 @@ class AdvectionFields {
     Image<float> image;
   };
   const Image<float>& cut(ImageView<const float> passes, int what);
-  const temporal::AdvectionField* find_locked(const Layer& layer, int frame) const;
-  mutable std::mutex mutex_;
   std::vector<std::unique_ptr<Cut>> cuts_;  // stable addresses
   std::function<std::vector<KeptField>()> kept_;
   StageClock* clock_;
