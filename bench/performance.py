@@ -174,23 +174,23 @@ def section_scaling(a, build):
 
 
 def section_memory(a, emaki, tmp):
-    """The huge-page restart: the same command with the tunable turned off, runs alternated."""
-    out = os.path.join(tmp, "stylit_thp.png")
-    cmd = [emaki, "synth"] + stylit_args() + ["-output", out, "--quiet"]
+    """The huge-page restart of the shot commands: six frames of the bundled shot, the tunable
+    turned off or not, runs alternated."""
     on, off = [], []
-    for _ in range(a.runs):
-        on.append(run_timed(cmd))
-        off.append(run_timed(cmd, env={"GLIBC_TUNABLES": HUGE_OFF}))
-    lines = ["## Huge pages", "",
-             f"The kernel's transparent-huge-page mode here: `{thp_mode()}` (emaki restarts "
-             "itself with huge pages only in `madvise` mode). The StyLit command above, "
-             f"{times_text(a.runs)} with `GLIBC_TUNABLES={HUGE_OFF}`:", "",
-             "| | wall s | CPU s | minor page faults |", "|---|---|---|---|",
-             "| default | {} | {:.2f} | {:,.0f} |".format(spread(on, "wall"), median(on, "cpu"),
-                                                          median(on, "faults")),
-             "| `GLIBC_TUNABLES={}` | {} | {:.2f} | {:,.0f} |".format(
-                 HUGE_OFF, spread(off, "wall"), median(off, "cpu"), median(off, "faults"))]
-    return lines
+    for i in range(a.runs):
+        for runs, env in ((on, None), (off, {"GLIBC_TUNABLES": HUGE_OFF})):
+            path = shot_copy(tmp, f"thp{i}{len(runs)}{'off' if env else 'on'}")
+            runs.append(run_timed([emaki, "run", path, "--frames", "0-5", "--no-previews"], env))
+    return ["## Huge pages", "",
+            f"The kernel's transparent-huge-page mode here: `{thp_mode()}` (the commands that make "
+            "shots' frames restart with huge pages only in `madvise` mode; `emaki synth` does "
+            "not). `emaki run examples/fox/shot.toml --frames 0-5 --no-previews` into an empty "
+            f"folder, {times_text(a.runs)} with `GLIBC_TUNABLES={HUGE_OFF}`:", "",
+            "| | wall s | CPU s | minor page faults |", "|---|---|---|---|",
+            "| default | {} | {:.2f} | {:,.0f} |".format(spread(on, "wall"), median(on, "cpu"),
+                                                         median(on, "faults")),
+            "| `GLIBC_TUNABLES={}` | {} | {:.2f} | {:,.0f} |".format(
+                HUGE_OFF, spread(off, "wall"), median(off, "cpu"), median(off, "faults"))]
 
 
 def section_render(a, build):

@@ -48,7 +48,7 @@ bool take_flags(int& argc, char**& argv, bool& digest, bool& one_layer) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  emaki::app::restart_with_huge_pages(argv);                      // as `emaki` does
+  emaki::app::restart_with_huge_pages(argv, "run");               // as `emaki run` does
   emaki::set_performance(emaki::performance_from_environment());  // as `emaki` does
   using namespace emaki;
   int width = 1920, height = 1080, frames = 3, threads = 0;

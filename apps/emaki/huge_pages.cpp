@@ -3,10 +3,18 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 
 namespace emaki::app {
+
+bool restarts_for_huge_pages(const char* command) {
+  if (!command) return false;
+  for (const char* c : {"run", "task", "render", "composite", "qa", "lookdev"})
+    if (std::strcmp(command, c) == 0) return true;
+  return false;
+}
 
 std::optional<std::string> huge_page_tunables(const char* tunables, const char* preload,
                                               const std::string& thp_mode) {
@@ -17,7 +25,8 @@ std::optional<std::string> huge_page_tunables(const char* tunables, const char* 
   return current.empty() ? "glibc.malloc.hugetlb=1" : current + ":glibc.malloc.hugetlb=1";
 }
 
-void restart_with_huge_pages(char** argv) {
+void restart_with_huge_pages(char** argv, const char* command) {
+  if (!restarts_for_huge_pages(command)) return;
   std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
   const std::string mode((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const char* before = std::getenv("GLIBC_TUNABLES");

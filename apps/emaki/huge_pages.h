@@ -3,13 +3,20 @@
 // glibc.malloc.hugetlb=1 has malloc advise huge pages on what it maps: 2 MB per fault instead of
 // 4 KB (a 6-frame `emaki run` of the example: 0.56 M page faults -> 0.03 M, wall -20 to -35 %;
 // docs/design/huge-pages.md). Tunables are read only when a program starts, so `emaki` starts
-// itself again once with the tunable added. Outputs do not change: only where memory comes from.
+// itself again once with the tunable added, for the commands that make shots' frames: the restart
+// loads every library again (about 20 ms of CPU), which `emaki synth` did not win back at any size
+// measured (its images of 4 MB or more take the advice themselves, core/performance.h) and the
+// quick commands never could. Outputs do not change: only where memory comes from.
 #pragma once
 
 #include <optional>
 #include <string>
 
 namespace emaki::app {
+
+// Whether `command` (emaki's first argument, may be null) makes shots' frames: run, task, render,
+// composite, qa, lookdev. Only those start again with huge pages.
+bool restarts_for_huge_pages(const char* command);
 
 // The GLIBC_TUNABLES value to start again with, or nullopt to go on as we are: when the kernel's
 // THP mode (the text of /sys/kernel/mm/transparent_hugepage/enabled, "always [madvise] never")
@@ -21,9 +28,10 @@ namespace emaki::app {
 std::optional<std::string> huge_page_tunables(const char* tunables, const char* preload,
                                               const std::string& thp_mode);
 
-// Starts this program again (same arguments, same pid) with the tunable added when
-// huge_page_tunables says so; returns when it does not, or when the restart fails (nothing
-// changes then). Call first thing in main, before any thread is started.
-void restart_with_huge_pages(char** argv);
+// Starts this program again (same arguments, same pid) with the tunable added when `command`
+// restarts (restarts_for_huge_pages) and huge_page_tunables says so; returns when it does not, or
+// when the restart fails (nothing changes then). Call first thing in main, before any thread is
+// started.
+void restart_with_huge_pages(char** argv, const char* command);
 
 }  // namespace emaki::app

@@ -27,6 +27,16 @@ TEST(HugePages, KeepsTheUsersTunablesAndTheirChoice) {
       std::nullopt);
 }
 
+TEST(HugePages, OnlyTheCommandsThatMakeShotsFramesRestart) {
+  for (const char* c : {"run", "task", "render", "composite", "qa", "lookdev"})
+    EXPECT_TRUE(restarts_for_huge_pages(c)) << c;
+  // synth takes the advice on its large images itself; the others are quick.
+  for (const char* c : {"synth", "template", "plan", "farm", "view", "version", "--version",
+                        "--help", "", "runx", "ru"})
+    EXPECT_FALSE(restarts_for_huge_pages(c)) << c;
+  EXPECT_FALSE(restarts_for_huge_pages(nullptr));
+}
+
 TEST(HugePages, NeverUnderValgrind) {
   // Valgrind preloads its core; /proc/self/exe is then its launcher, which refuses to run.
   EXPECT_EQ(

@@ -85,9 +85,9 @@ void print_usage() {
 
 int main(int argc, char** argv) {
   using namespace emaki::app;
-  // Large buffers on huge pages where the kernel takes advice (huge_pages.h,
-  // docs/design/huge-pages.md).
-  restart_with_huge_pages(argv);
+  // Large buffers on huge pages where the kernel takes advice, for the commands that make shots'
+  // frames (huge_pages.h, docs/design/huge-pages.md).
+  restart_with_huge_pages(argv, argc > 1 ? argv[1] : nullptr);
   // The one performance switch (core/performance.h): huge-page advice on large images, SIMD
   // kernels unless EMAKI_SIMD=scalar.
   emaki::set_performance(emaki::performance_from_environment());
