@@ -7,6 +7,12 @@
 #   FARM_BENCH_SHOTS="examples/fox/shot.toml examples/town/shot.toml" bench/farm_bench.sh
 #     (other shots than the production's, paths from the repository's root)
 #   FARM_BENCH_REPEAT=3 bench/farm_bench.sh  (run and tasks measured 3 times, alternated)
+#   FARM_BENCH_CALLGRIND=1 FARM_BENCH_SLURM=0 bench/farm_bench.sh
+#     (every command under valgrind's callgrind: user-space instructions, in billions, instead
+#     of CPU seconds; the same figure under any load and on any machine of the architecture,
+#     about 50 times slower. Kernel work, the page faults and the pass cache's writes, is not
+#     counted, nor the run's split by stage, which comes from its clock; ffmpeg's, a child, in
+#     neither.)
 # Each run writes its own output folders (N: the repetition):
 #   runN    `emaki run SHOT --threads 1` for each shot in turn
 #   tasksN  the plan's tasks (`--threads 1`) run here one by one, stage by stage, without a
@@ -20,6 +26,9 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 emaki=${1:-$root/build/release/apps/emaki/emaki}
 work=${2:-/tmp/emaki_farm_bench}
 use_slurm=${FARM_BENCH_SLURM:-1}
+callgrind=${FARM_BENCH_CALLGRIND:-0}
+cost=CPU
+[ "$callgrind" = 1 ] && cost=Ginstr
 chunk=8
 cores=$(nproc)
 rm -rf "$work"
@@ -48,8 +57,18 @@ shot_files() { echo "$work/$1"/*/shot.toml; }
 now() { date +%s.%N; }
 secs() { awk -v a="$1" -v b="$2" 'BEGIN { print b - a }'; }
 calc() { awk "BEGIN { printf \"%.2f\", $1 }"; }
-# timed CMD...: runs it, prints "WALL CPU" (CPU = user + system, seconds).
+# timed CMD...: runs it, prints "WALL CPU" (CPU = user + system, seconds; with
+# FARM_BENCH_CALLGRIND=1 the instructions callgrind counted, in billions, instead).
 timed() {
+  if [ "$callgrind" = 1 ]; then
+    rm -f "$work"/callgrind.*
+    /usr/bin/time -f "%e" -o "$work/time" valgrind -q --tool=callgrind \
+      --callgrind-out-file="$work/callgrind.%p" "$@" >/dev/null 2>"$work/stderr" ||
+      echo "failed: $* ($(tail -n 1 "$work/stderr"))" >&2
+    awk -v w="$(tail -n 1 "$work/time")" '$1 == "summary:" { n += $2 }
+      END { printf "%.2f %.3f\n", w, n / 1e9 }' "$work"/callgrind.*
+    return
+  fi
   /usr/bin/time -f "%e %U %S" -o "$work/time" "$@" >/dev/null 2>"$work/stderr" ||
     echo "failed: $* ($(tail -n 1 "$work/stderr"))" >&2
   tail -n 1 "$work/time" | awk '{ printf "%.2f %.2f\n", $1, $2 + $3 }'
@@ -83,6 +102,7 @@ measure_run() {
   for s in $(shot_files "$1"); do
     read -r w c < <(timed "$emaki" run "$s" --threads 1 --timings)
     run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
+    [ "$callgrind" = 1 ] && continue  # the stage clock's CPU seconds are not instructions
     while read -r kind w c; do
       run_stage_wall[$kind]=$(calc "${run_stage_wall[$kind]} + $w")
       run_stage_cpu[$kind]=$(calc "${run_stage_cpu[$kind]} + $c")
@@ -151,8 +171,8 @@ echo "shots: $shots; $tasks tasks (chunk $chunk, 1 thread each)"
 [ "$reps" = 1 ] || echo "mean of $reps repetitions"
 # Per stage: `emaki run`'s own split (--timings; the process's start and exit fall outside it)
 # against the tasks of that kind, each a whole process.
-printf '%-22s %9s %9s %13s %13s %9s\n' "stage" "run wall" "run CPU" "tasks wall" "tasks CPU" \
-  "CPU ratio"
+printf '%-22s %9s %9s %13s %13s %9s\n' "stage" "run wall" "run $cost" "tasks wall" \
+  "tasks $cost" "$cost ratio"
 for kind in prepare passes layer composite previews; do
   ratio=$(awk -v t="${stage_cpu[$kind]}" -v r="${run_stage_cpu[$kind]}" \
     'BEGIN { if (r > 0) printf "%.2fx", t / r; else print "n/a" }')
@@ -163,7 +183,11 @@ done
 printf '%-22s %9.1f %9.1f %13.1f %13.1f %9s\n' "all (whole processes)" "$(mean "$run_wall")" \
   "$(mean "$run_cpu")" "$(mean "$tasks_wall")" "$(mean "$tasks_cpu")" \
   "$(calc "$tasks_cpu / $run_cpu")x"
-echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x CPU time"
+if [ "$callgrind" = 1 ]; then
+  echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x user-space instructions (callgrind)"
+else
+  echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x CPU time"
+fi
 if [ "$reps" != 1 ]; then
   echo "per repetition:$ratios; median $(printf '%s\n' $ratios | sort -n |
     awk '{ v[NR] = $1 } END { printf "%.2f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }')"
