@@ -57,8 +57,8 @@ shot_files() { echo "$work/$1"/*/shot.toml; }
 now() { date +%s.%N; }
 secs() { awk -v a="$1" -v b="$2" 'BEGIN { print b - a }'; }
 calc() { awk "BEGIN { printf \"%.2f\", $1 }"; }
-# timed CMD...: runs it, prints "WALL CPU" (CPU = user + system, seconds; with
-# FARM_BENCH_CALLGRIND=1 the instructions callgrind counted, in billions, instead).
+# timed CMD...: runs it, prints "WALL CPU SYSTEM" (CPU = user + system, seconds; with
+# FARM_BENCH_CALLGRIND=1 the instructions callgrind counted, in billions, instead, and 0).
 timed() {
   if [ "$callgrind" = 1 ]; then
     rm -f "$work"/callgrind.*
@@ -66,12 +66,12 @@ timed() {
       --callgrind-out-file="$work/callgrind.%p" "$@" >/dev/null 2>"$work/stderr" ||
       echo "failed: $* ($(tail -n 1 "$work/stderr"))" >&2
     awk -v w="$(tail -n 1 "$work/time")" '$1 == "summary:" { n += $2 }
-      END { printf "%.2f %.3f\n", w, n / 1e9 }' "$work"/callgrind.*
+      END { printf "%.2f %.3f 0\n", w, n / 1e9 }' "$work"/callgrind.*
     return
   fi
   /usr/bin/time -f "%e %U %S" -o "$work/time" "$@" >/dev/null 2>"$work/stderr" ||
     echo "failed: $* ($(tail -n 1 "$work/stderr"))" >&2
-  tail -n 1 "$work/time" | awk '{ printf "%.2f %.2f\n", $1, $2 + $3 }'
+  tail -n 1 "$work/time" | awk '{ printf "%.2f %.2f %.2f\n", $1, $2 + $3, $3 }'
 }
 # The MP4 is left out: libx264 here encodes the same PNGs to different bytes from one run to the
 # next (two `emaki task previews` of one folder differed).
@@ -97,11 +97,11 @@ for kind in prepare passes layer composite previews; do
   run_stage_wall[$kind]=0 run_stage_cpu[$kind]=0
 done
 measure_run() {
-  local s w c kind
+  local s w c k kind
   copy_shots "$1"
   for s in $(shot_files "$1"); do
-    read -r w c < <(timed "$emaki" run "$s" --threads 1 --timings)
-    run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c")
+    read -r w c k < <(timed "$emaki" run "$s" --threads 1 --timings)
+    run_wall=$(calc "$run_wall + $w") run_cpu=$(calc "$run_cpu + $c") run_sys=$(calc "$run_sys + $k")
     [ "$callgrind" = 1 ] && continue  # the stage clock's CPU seconds are not instructions
     while read -r kind w c; do
       run_stage_wall[$kind]=$(calc "${run_stage_wall[$kind]} + $w")
@@ -118,7 +118,7 @@ case ":${GLIBC_TUNABLES-}:" in
 esac
 # measure_tasks DIR: the plan's tasks into DIR, stage by stage; adds to stage_wall, stage_cpu.
 measure_tasks() {
-  local dir=$1 kind line w c  # `set --` below takes the positional parameters
+  local dir=$1 kind line w c k  # `set --` below takes the positional parameters
   copy_shots "$dir"
   "$emaki" plan $(shot_files "$dir") --chunk $chunk --threads 1 --json >"$work/$dir/plan.json"
   tasks=$(grep -c '"id":' "$work/$dir/plan.json")
@@ -126,7 +126,8 @@ measure_tasks() {
     stage_n[$kind]=0
     while IFS= read -r -d '' line; do
       eval "set -- $line"
-      read -r w c < <(GLIBC_TUNABLES=$task_tunables timed "$@")
+      read -r w c k < <(GLIBC_TUNABLES=$task_tunables timed "$@")
+      tasks_sys=$(calc "$tasks_sys + $k")
       stage_wall[$kind]=$(calc "${stage_wall[$kind]} + $w")
       stage_cpu[$kind]=$(calc "${stage_cpu[$kind]} + $c")
       stage_n[$kind]=$((stage_n[$kind] + 1))
@@ -150,7 +151,7 @@ stage_total() {
 # FARM_BENCH_REPEAT=N measures both N times, alternating which goes first, each into fresh
 # folders: one machine's CPU time moves by more than the ratio's margin from one run to the next.
 reps=${FARM_BENCH_REPEAT:-1}
-run_wall=0 run_cpu=0 ratios="" same_all=identical
+run_wall=0 run_cpu=0 run_sys=0 tasks_sys=0 ratios="" same_all=identical
 for ((i = 1; i <= reps; i++)); do
   r0=$run_cpu t0=$(stage_total stage_cpu)
   if ((i % 2)); then
@@ -187,6 +188,9 @@ if [ "$callgrind" = 1 ]; then
   echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x user-space instructions (callgrind)"
 else
   echo "tasks vs emaki run: $(calc "$tasks_cpu / $run_cpu")x CPU time"
+  # The kernel's part (page faults, the pass cache's writes): callgrind does not count it.
+  echo "of which system time: run $(mean "$run_sys") s, tasks $(mean "$tasks_sys") s;" \
+    "user time alone $(calc "($tasks_cpu - $tasks_sys) / ($run_cpu - $run_sys)")x"
 fi
 if [ "$reps" != 1 ]; then
   echo "per repetition:$ratios; median $(printf '%s\n' $ratios | sort -n |
