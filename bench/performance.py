@@ -179,7 +179,7 @@ def section_memory(a, emaki, tmp):
     on, off = [], []
     for i in range(a.runs):
         for runs, env in ((on, None), (off, {"GLIBC_TUNABLES": HUGE_OFF})):
-            path = shot_copy(tmp, f"thp{i}{len(runs)}{'off' if env else 'on'}")
+            path = shot_copy(tmp, f"thp{i}{'off' if env else 'on'}")
             runs.append(run_timed([emaki, "run", path, "--frames", "0-5", "--no-previews"], env))
     return ["## Huge pages", "",
             f"The kernel's transparent-huge-page mode here: `{thp_mode()}` (the commands that make "
