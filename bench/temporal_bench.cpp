@@ -12,7 +12,7 @@
 //                  [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N]
 //                  [--temporal-weight W] [--temporal-uniformity U]
 //                  [--judge PATH/TO/judge] [--judge-every 8] [--judge-dir DIR] [--save DIR]
-//                  [--threads N] [--painting-scale S]
+//                  [--threads N] [--painting-scale S] [--touch-sigma 1]
 //
 // Variants: `frame` (temporal = false; the reference of the ghost figures, so list it first),
 // `position`, `rest_position` (with confidence, the default), `position_noconf`,
@@ -23,6 +23,9 @@
 // --error-*, --foreign-none, --erode: temporal::ConfidenceParams; --temporal-weight: every
 // temporal variant's without @W. The judge (../shared/tools/judge, its build.sh) takes the
 // layer's guides and weights; outside the layer's mask every variant's output is white.
+// --touch-sigma: the flicker is also measured on values low-passed by a Gaussian of this many
+// pixels (bench::low_passed_value), where a picture stuck to its surfaces scores far less (the
+// `stuck` figure printed beside it) and a touch that changes still counts.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -69,6 +72,7 @@ struct Options {
   bool confidence_set = false;        // any of --error-*, --foreign-none, --erode given
   float temporal_weight = -1.0f;      // -1: the example's
   double painting_scale = 1.0;        // the paintings resampled by this (Exemplar::scale)
+  float touch_sigma = 1.0f;           // the flicker measured again on values low-passed by this
   float temporal_uniformity = -1.0f;  // for `_uniform` variants; -1: the layer's uniformity
 };
 
@@ -79,7 +83,8 @@ struct Options {
       "NAME] "
       "[--variants a,b,...] [--error-full X] [--error-none Y] [--foreign-none Z] [--erode N] "
       "[--temporal-weight W] [--temporal-uniformity U] [--judge PATH] "
-      "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N] [--painting-scale S]\n",
+      "[--judge-every K] [--judge-dir DIR] [--save DIR] [--threads N] [--painting-scale S] "
+      "[--touch-sigma S]\n",
       why.c_str());
   std::exit(2);
 }
@@ -152,6 +157,8 @@ Options parse(int argc, char** argv) {
       o.save = v;
     } else if (a == "--threads") {
       o.threads = std::atoi(v.c_str());
+    } else if (a == "--touch-sigma") {
+      o.touch_sigma = std::max(0.1f, std::strtof(v.c_str(), nullptr));
     } else if (a == "--painting-scale") {
       o.painting_scale = std::strtod(v.c_str(), nullptr);
     } else {
@@ -188,6 +195,8 @@ struct Variant {
   pipeline::SequenceFlicker flicker;
   pipeline::SequenceFlicker held_flicker;  // where the light held (bench::light_held)
   pipeline::SequenceFlicker stuck;  // t-1 carried in whole pixels (bench::carried_whole_pixels)
+  // The same two at the touches' scale (bench::low_passed_value, opt.touch_sigma).
+  pipeline::SequenceFlicker touch_flicker, touch_stuck;
   pipeline::GhostStats ghost;
   double style_sum = 0.0, coverage_sum = 0.0;
   double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
@@ -436,10 +445,18 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
   const int mask_channel = cur.channels() > n ? n : -1;
   v.flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                         prev_passes.cview(), mask_channel));
-  if (!v.layer.temporal.enabled)
-    v.stuck.add(pipeline::frame_flicker(bench::carried_whole_pixels(prev, passes.cview()).cview(),
-                                        prev.cview(), passes.cview(), prev_passes.cview(),
-                                        mask_channel));
+  const Image<float> cur_low = bench::low_passed_value(cur, n, opt.touch_sigma),
+                     prev_low = bench::low_passed_value(prev, n, opt.touch_sigma);
+  v.touch_flicker.add(pipeline::frame_flicker(cur_low.cview(), prev_low.cview(), passes.cview(),
+                                              prev_passes.cview(), mask_channel));
+  if (!v.layer.temporal.enabled) {
+    const Image<float> carried = bench::carried_whole_pixels(prev, passes.cview());
+    v.stuck.add(pipeline::frame_flicker(carried.cview(), prev.cview(), passes.cview(),
+                                        prev_passes.cview(), mask_channel));
+    v.touch_stuck.add(pipeline::frame_flicker(
+        bench::low_passed_value(carried, n, opt.touch_sigma).cview(), prev_low.cview(),
+        passes.cview(), prev_passes.cview(), mask_channel));
+  }
   if (!held.empty())
     v.held_flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                                prev_passes.cview(), mask_channel, nullptr, &held));
@@ -498,6 +515,13 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
   if (ref && base.stuck.all.pixels)
     std::printf("stuck (frame by frame's t-1 carried to t in whole pixels) %8.2fx\n",
                 base.stuck.all.mean() / base.flicker.all.mean());
+  if (ref && base.touch_stuck.all.pixels && base.touch_flicker.all.mean() > 0.0) {
+    std::printf("flicker at the touches' scale (values low-passed, sigma %.1f):", opt.touch_sigma);
+    for (const Variant& v : variants)
+      std::printf(" %s %.2fx", v.name.c_str(),
+                  v.touch_flicker.all.mean() / base.touch_flicker.all.mean());
+    std::printf("; stuck %.2fx\n", base.touch_stuck.all.mean() / base.touch_flicker.all.mean());
+  }
 }
 
 // Against frame by frame, same pixels: tone drift and texture kept inside the mask over the last

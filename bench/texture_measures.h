@@ -23,6 +23,7 @@
 #include "pipeline/temporal_guide.h"
 #include "render/passes.h"
 #include "temporal/confidence.h"
+#include "temporal/guide_change.h"
 
 namespace emaki::bench {
 
@@ -119,6 +120,28 @@ inline Image<float> carried_whole_pixels(const Image<float>& previous,
       const int sx = std::clamp(q.x, 0, w - 1), sy = std::clamp(q.y, 0, h - 1);
       for (int c = 0; c < previous.channels(); ++c) out(x, y, c) = previous(sx, sy, c);
     }
+  return out;
+}
+
+// The first `n` channels of a layer's value low-passed by a Gaussian of `sigma` pixels inside
+// its coverage (channel n, when it has one), the coverage kept. The flicker measure on such
+// values compares frames at the scale of the painting's touches: a picture moved by a fraction
+// of a pixel differs far less from t-1 sampled between pixels than at full detail (the `stuck`
+// figure), while a touch that changes still does.
+inline Image<float> low_passed_value(const Image<float>& v, int n, float sigma) {
+  const int w = v.width(), h = v.height();
+  Image<float> value(w, h, n), mask;
+  if (v.channels() > n) mask = Image<float>(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < n; ++c) value(x, y, c) = v(x, y, c);
+      if (!mask.empty()) mask(x, y, 0) = v(x, y, n) >= 0.5f ? 1.0f : 0.0f;
+    }
+  const Image<float> low = temporal::low_pass(value.cview(), sigma, mask.cview());
+  Image<float> out = v.clone();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < n; ++c) out(x, y, c) = low(x, y, c);
   return out;
 }
 
