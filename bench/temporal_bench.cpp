@@ -195,8 +195,8 @@ struct Variant {
   pipeline::SequenceFlicker flicker;
   pipeline::SequenceFlicker held_flicker;  // where the light held (bench::light_held)
   pipeline::SequenceFlicker stuck;  // t-1 carried in whole pixels (bench::carried_whole_pixels)
-  // The same two at the touches' scale (bench::low_passed_value, opt.touch_sigma).
-  pipeline::SequenceFlicker touch_flicker, touch_stuck;
+  // flicker, stuck and held_flicker at the touches' scale (bench::low_passed_value, --touch-sigma).
+  pipeline::SequenceFlicker touch_flicker, touch_stuck, touch_held;
   pipeline::GhostStats ghost;
   double style_sum = 0.0, coverage_sum = 0.0;
   double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
@@ -457,9 +457,12 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
         bench::low_passed_value(carried, n, opt.touch_sigma).cview(), prev_low.cview(),
         passes.cview(), prev_passes.cview(), mask_channel));
   }
-  if (!held.empty())
+  if (!held.empty()) {
     v.held_flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                                prev_passes.cview(), mask_channel, nullptr, &held));
+    v.touch_held.add(pipeline::frame_flicker(cur_low.cview(), prev_low.cview(), passes.cview(),
+                                             prev_passes.cview(), mask_channel, nullptr, &held));
+  }
   if (reference.name == "frame" && v.layer.temporal.enabled) {
     const Image<float> ref = reference.store.read_layer(layer, f);
     v.ghost.add(pipeline::frame_ghost(v.layer, cur.cview(), prev.cview(), ref.cview(),
@@ -521,6 +524,13 @@ void print_table(const std::vector<Variant>& variants, const Options& opt, int f
       std::printf(" %s %.2fx", v.name.c_str(),
                   v.touch_flicker.all.mean() / base.touch_flicker.all.mean());
     std::printf("; stuck %.2fx\n", base.touch_stuck.all.mean() / base.touch_flicker.all.mean());
+    if (base.touch_held.all.mean() > 0.0) {
+      std::printf("the same where the light held:");
+      for (const Variant& v : variants)
+        std::printf(" %s %.2fx", v.name.c_str(),
+                    v.touch_held.all.mean() / base.touch_held.all.mean());
+      std::printf("\n");
+    }
   }
 }
 
