@@ -198,6 +198,8 @@ struct Variant {
   pipeline::SequenceFlicker stuck;  // t-1 carried in whole pixels (bench::carried_whole_pixels)
   // flicker, stuck and held_flicker at the touches' scale (bench::low_passed_value, --touch-sigma).
   pipeline::SequenceFlicker touch_flicker, touch_stuck, touch_held;
+  Image<float> last_low;  // the last measured frame's value low-passed: t-1's at the next frame
+  int last_low_frame = -1;
   pipeline::GhostStats ghost;
   double style_sum = 0.0, coverage_sum = 0.0;
   double drift_sum = 0.0;  // mean value against frame by frame, summed over the last quarter
@@ -374,8 +376,10 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
   const int mask_channel = cur.channels() > n ? n : -1;
   v.flicker.add(pipeline::frame_flicker(cur.cview(), prev.cview(), passes.cview(),
                                         prev_passes.cview(), mask_channel));
-  const Image<float> cur_low = bench::low_passed_value(cur, n, opt.touch_sigma),
-                     prev_low = bench::low_passed_value(prev, n, opt.touch_sigma);
+  Image<float> cur_low = bench::low_passed_value(cur, n, opt.touch_sigma);
+  const Image<float> prev_low = v.last_low_frame == f - 1
+                                    ? std::move(v.last_low)
+                                    : bench::low_passed_value(prev, n, opt.touch_sigma);
   v.touch_flicker.add(pipeline::frame_flicker(cur_low.cview(), prev_low.cview(), passes.cview(),
                                               prev_passes.cview(), mask_channel));
   if (!v.layer.temporal.enabled) {
@@ -409,6 +413,8 @@ void measure_frame(Variant& v, const Variant& reference, const pipeline::Layer& 
   }
   if (!opt.save.empty())
     write_png(fmt::format("{}/{}_{:04d}.png", opt.save, v.name, f), on_white(cur, n));
+  v.last_low = std::move(cur_low);
+  v.last_low_frame = f;
 }
 
 void print_table(const std::vector<Variant>& variants, const Options& opt, int first, int last,
