@@ -2,6 +2,7 @@
 // decoded only here, when a material uses them, within kMaxTexturePixels over the scene.
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -21,27 +22,32 @@ float srgb_to_linear(float c) {
 // tinygltf's decoded 8- or 16-bit grey, grey+alpha, RGB or RGBA pixels as linear float RGBA
 // (the colour channels are sRGB-encoded in glTF, alpha is linear).
 scene::Texture to_linear_rgba(const tinygltf::Image& img, int comps, int bytes) {
+  // An 8-bit level's linear value, computed once per level rather than once per pixel (the
+  // same floats: the same expression on the same input).
+  std::array<float, 256> linear8{};
+  if (bytes == 1)
+    for (int i = 0; i < 256; ++i) linear8[i] = srgb_to_linear(i / 255.0f);
   Image<float> rgba(img.width, img.height, 4);
   for (int y = 0; y < img.height; ++y) {
     float* row = rgba.row(y);
     for (int x = 0; x < img.width; ++x) {
-      float v[4] = {0, 0, 0, 1};
+      float v[4] = {0, 0, 0, 1};  // RGB linear, alpha as stored
       for (int c = 0; c < comps; ++c) {
         const std::size_t i = (std::size_t(y) * img.width + x) * comps + c;
+        const bool colour = c < 3 && !(comps == 2 && c == 1);
         if (bytes == 2) {
           uint16_t u;
           std::memcpy(&u, img.image.data() + 2 * i, 2);
-          v[c] = u / 65535.0f;
+          v[c] = colour ? srgb_to_linear(u / 65535.0f) : u / 65535.0f;
         } else {
-          v[c] = img.image[i] / 255.0f;
+          v[c] = colour ? linear8[img.image[i]] : img.image[i] / 255.0f;
         }
       }
       if (comps < 3) {  // grey (+ alpha)
         if (comps == 2) v[3] = v[1];
         v[1] = v[2] = v[0];
       }
-      for (int c = 0; c < 3; ++c) row[4 * x + c] = srgb_to_linear(v[c]);
-      row[4 * x + 3] = v[3];
+      std::memcpy(row + 4 * x, v, sizeof v);
     }
   }
   scene::Texture out;

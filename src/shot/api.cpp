@@ -102,7 +102,9 @@ RunResult run_with(const pipeline::Shot& shot, const Request& request, InputCach
        TaskKind::kPasses},
       &rendered, cache);
   const auto frames = open_frames(shot, cache);
-  const pipeline::CompositeInputs ci = load_composite_inputs(shot, cache);
+  // A layer task composites nothing: the prepare task has checked the compositing inputs.
+  const pipeline::CompositeInputs ci =
+      request.composite ? load_composite_inputs(shot, cache) : pipeline::CompositeInputs{};
   const pipeline::WeightMapImages maps = load_weight_maps(shot, cache);
   if (cache) cache->drop_unused();
   RunResult out;
