@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "apps/emaki/commands.h"
+#include "apps/emaki/huge_pages.h"
 #include "apps/emaki/shot_command.h"
 #include "core/error.h"
 #include "core/limits.h"
@@ -238,6 +239,7 @@ int run_task(const Args& args) {
   if (parse_cli(app, Args(args.begin() + 1, args.end()))) return 0;
   // A task's log (its stdout and stderr) starts with the emaki that ran it: which version made
   // a frame on the farm. On stdout, so that an error stays stderr's one line.
+  keep_freed_memory();  // a chunk's frames reuse the memory the frames before them freed
   std::printf("emaki task: emaki %s\n", version());
   std::fflush(stdout);
   const pipeline::Shot shot = shot::open(c.shot_path);

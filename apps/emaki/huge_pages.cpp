@@ -1,5 +1,6 @@
 #include "apps/emaki/huge_pages.h"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -40,6 +41,12 @@ void restart_with_huge_pages(char** argv, const char* command) {
     ::setenv("GLIBC_TUNABLES", kept.c_str(), 1);
   else
     ::unsetenv("GLIBC_TUNABLES");
+}
+
+bool keep_freed_memory() {
+  constexpr int kMmapThreshold = 256 << 20, kTrimThreshold = 1 << 30;
+  const bool mapped = ::mallopt(M_MMAP_THRESHOLD, kMmapThreshold) == 1;
+  return ::mallopt(M_TRIM_THRESHOLD, kTrimThreshold) == 1 && mapped;
 }
 
 }  // namespace emaki::app

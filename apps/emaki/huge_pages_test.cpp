@@ -2,6 +2,10 @@
 #include "apps/emaki/huge_pages.h"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
+
+#include <cstdlib>
+#include <cstring>
 
 namespace emaki::app {
 namespace {
@@ -44,6 +48,27 @@ TEST(HugePages, NeverUnderValgrind) {
       std::nullopt);
   EXPECT_EQ(huge_page_tunables(nullptr, "/usr/lib/libsomething.so", kMadvise),
             "glibc.malloc.hugetlb=1");
+}
+
+TEST(HugePages, AFarmTaskKeepsItsFreedMemoryInTheHeap) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's allocator takes no glibc malloc settings";
+#endif
+  ASSERT_TRUE(keep_freed_memory());
+  // A 64 MB block (a 1080p frame's passes hold more) comes from the heap, not a mapping of its
+  // own, and freeing it hands nothing back: the next one reuses the same pages.
+  constexpr std::size_t kBytes = std::size_t(64) << 20;
+  const std::size_t mapped_before = mallinfo2().hblkhd;
+  void* a = std::malloc(kBytes);
+  ASSERT_NE(a, nullptr);
+  std::memset(a, 1, kBytes);
+  EXPECT_EQ(mallinfo2().hblkhd, mapped_before);
+  const std::size_t heap = mallinfo2().arena;
+  std::free(a);
+  EXPECT_EQ(mallinfo2().arena, heap);
+  void* b = std::malloc(kBytes);
+  EXPECT_EQ(mallinfo2().arena, heap);
+  std::free(b);
 }
 
 }  // namespace
