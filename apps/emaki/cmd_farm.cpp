@@ -237,9 +237,9 @@ int run_task(const Args& args) {
   c.bind(app, "FIRST-LAST or FRAME");
   if (kind == "layer") app.add_option("--layer", layer, "the layer")->required();
   if (parse_cli(app, Args(args.begin() + 1, args.end()))) return 0;
+  keep_freed_memory();  // a chunk's frames reuse the memory the frames before them freed
   // A task's log (its stdout and stderr) starts with the emaki that ran it: which version made
   // a frame on the farm. On stdout, so that an error stays stderr's one line.
-  keep_freed_memory();  // a chunk's frames reuse the memory the frames before them freed
   std::printf("emaki task: emaki %s\n", version());
   std::fflush(stdout);
   const pipeline::Shot shot = shot::open(c.shot_path);
